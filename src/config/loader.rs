@@ -1,0 +1,104 @@
+//! One parse-and-validate path for both the asset server and plain files.
+
+use super::{ConfigError, Validate, Validator};
+use bevy::asset::{Asset, AssetLoader, LoadContext, io::Reader};
+use bevy::reflect::TypePath;
+use serde::de::DeserializeOwned;
+use std::marker::PhantomData;
+use std::path::Path;
+
+/// Parses RON bytes into `T` and validates it; every error names `file`.
+pub fn parse_ron<T: DeserializeOwned + Validate>(
+    bytes: &[u8],
+    file: &Path,
+) -> Result<T, ConfigError> {
+    if bytes.iter().all(u8::is_ascii_whitespace) {
+        return Err(ConfigError::one(file, "", "the file is empty"));
+    }
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        ConfigError::one(
+            file,
+            "",
+            format!(
+                "not a RON text file: invalid UTF-8 at byte {}",
+                e.valid_up_to()
+            ),
+        )
+    })?;
+    let value: T = ron::from_str(text).map_err(|e| parse_error(file, e))?;
+    let mut v = Validator::default();
+    value.validate(&mut v);
+    v.finish(file)?;
+    Ok(value)
+}
+
+/// Reads and parses one asset file by path (the headless CLI and the tests).
+pub fn load_file<T: DeserializeOwned + Validate>(file: &Path) -> Result<T, ConfigError> {
+    let bytes = std::fs::read(file)
+        .map_err(|e| ConfigError::one(file, "", format!("cannot read the file: {e}")))?;
+    parse_ron(&bytes, file)
+}
+
+fn parse_error(file: &Path, e: ron::error::SpannedError) -> ConfigError {
+    use ron::Error;
+    let field = match &e.code {
+        Error::MissingStructField { field, .. } => (*field).to_owned(),
+        Error::NoSuchStructField { found, .. } => found.clone(),
+        Error::DuplicateStructField { field, .. } => (*field).to_owned(),
+        _ => String::new(),
+    };
+    let message = match &e.code {
+        Error::MissingStructField { .. } => "is missing".to_owned(),
+        Error::NoSuchStructField { expected, .. } => {
+            format!(
+                "is not a known field (line {}); expected one of: {}",
+                e.position.line,
+                expected.join(", ")
+            )
+        }
+        code => format!(
+            "line {}, column {}: {code}",
+            e.position.line, e.position.col
+        ),
+    };
+    ConfigError::one(file, field, message)
+}
+
+/// Bevy asset loader for any validated RON asset type: the game's hot-reload path.
+#[derive(TypePath)]
+pub struct RonAssetLoader<T> {
+    _asset: PhantomData<fn() -> T>,
+}
+
+impl<T> Default for RonAssetLoader<T> {
+    fn default() -> Self {
+        Self {
+            _asset: PhantomData,
+        }
+    }
+}
+
+impl<T: Asset + DeserializeOwned + Validate> AssetLoader for RonAssetLoader<T> {
+    type Asset = T;
+    type Settings = ();
+    type Error = ConfigError;
+
+    async fn load(
+        &self,
+        reader: &mut dyn Reader,
+        _settings: &(),
+        load_context: &mut LoadContext<'_>,
+    ) -> Result<T, ConfigError> {
+        let file = load_context.path().path().to_path_buf();
+        let mut bytes = Vec::new();
+        reader
+            .read_to_end(&mut bytes)
+            .await
+            .map_err(|e| ConfigError::one(&file, "", format!("cannot read the file: {e}")))?;
+        parse_ron(&bytes, &file)
+    }
+
+    fn extensions(&self) -> &[&str] {
+        &["ron"]
+    }
+}

@@ -1,0 +1,143 @@
+//! The asset files: serde types, their loader and their validation.
+//!
+//! Every number a designer tunes lives in a RON file under `assets/`, with its unit in the
+//! field name. One parse-and-validate path serves both Bevy's asset server (the game, with
+//! hot reload) and plain file paths (the headless CLI and the tests).
+
+mod arena;
+mod creature;
+mod loader;
+mod scenario;
+mod validate;
+
+pub use arena::{ArenaConfig, PuckConfig};
+pub use creature::{BodyConfig, CreatureDef, SteeringConfig};
+pub use loader::{RonAssetLoader, load_file, parse_ron};
+pub use scenario::{CreatureGroup, Scenario};
+pub use validate::{ConfigError, Problem, Validate, Validator};
+
+use bevy::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Everything one simulation run is built from: the scenario and the files it names.
+#[derive(Resource, Clone, Debug)]
+pub struct SimConfig {
+    pub scenario: Scenario,
+    pub arena: ArenaConfig,
+    /// Creature definitions, indexed by [`crate::creature::Creature::kind`].
+    pub kinds: Vec<CreatureDef>,
+}
+
+impl SimConfig {
+    /// Loads a scenario file and the arena and creature files it names, resolved against
+    /// `assets_root` (`arena` is a path under it; a creature kind `k` is
+    /// `creatures/k.ron`). Every problem is reported with the file it is in.
+    pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
+        let scenario: Scenario = load_file(scenario_path)?;
+        let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
+        let mut kinds = Vec::with_capacity(scenario.creatures.len());
+        for (i, group) in scenario.creatures.iter().enumerate() {
+            if kinds.iter().any(|k: &CreatureDef| k.name == group.kind) {
+                continue;
+            }
+            let path = creature_file(assets_root, &group.kind);
+            if !path.is_file() {
+                return Err(ConfigError::one(
+                    scenario_path,
+                    format!("creatures[{i}].kind"),
+                    format!(
+                        "unknown creature kind {:?}: there is no {}; known kinds: {}",
+                        group.kind,
+                        path.display(),
+                        known_kinds(assets_root).join(", ")
+                    ),
+                ));
+            }
+            let def: CreatureDef = load_file(&path)?;
+            if def.name != group.kind {
+                return Err(ConfigError::one(
+                    &path,
+                    "name",
+                    format!(
+                        "is {:?} but the file is named for kind {:?}",
+                        def.name, group.kind
+                    ),
+                ));
+            }
+            kinds.push(def);
+        }
+        let config = Self {
+            scenario,
+            arena,
+            kinds,
+        };
+        config.check_fit(scenario_path)?;
+        Ok(config)
+    }
+
+    /// Index of a creature kind by name.
+    pub fn kind_index(&self, name: &str) -> Option<usize> {
+        self.kinds.iter().position(|k| k.name == name)
+    }
+
+    /// Checks that span files: every creature fits in the court beside the puck.
+    fn check_fit(&self, scenario_path: &Path) -> Result<(), ConfigError> {
+        let biggest = self
+            .kinds
+            .iter()
+            .map(|k| k.body.radius_m)
+            .fold(0.0, f32::max);
+        let half = self.arena.half_extents();
+        if half.min_element() <= self.arena.puck.radius_m + 2.0 * biggest {
+            return Err(ConfigError::one(
+                scenario_path,
+                "arena",
+                format!(
+                    "the court ({} x {} m) leaves no room beside the puck (radius {} m) for a creature (radius {} m)",
+                    self.arena.court_length_m,
+                    self.arena.court_width_m,
+                    self.arena.puck.radius_m,
+                    biggest
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The file a creature kind is defined in.
+pub fn creature_file(assets_root: &Path, kind: &str) -> PathBuf {
+    assets_root.join("creatures").join(format!("{kind}.ron"))
+}
+
+fn known_kinds(assets_root: &Path) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(assets_root.join("creatures"))
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| {
+            let p = e.path();
+            if p.extension()? == "ron" {
+                Some(p.file_stem()?.to_string_lossy().into_owned())
+            } else {
+                None
+            }
+        })
+        .collect();
+    names.sort();
+    names
+}
+
+/// Registers the asset types and their loader with Bevy's asset server, when it is present.
+pub(super) fn plugin(app: &mut App) {
+    if app.is_plugin_added::<bevy::asset::AssetPlugin>() {
+        // All three share the `.ron` extension: the asset server picks the loader by the
+        // asset type asked for.
+        app.init_asset::<Scenario>()
+            .init_asset::<ArenaConfig>()
+            .init_asset::<CreatureDef>()
+            .init_asset_loader::<RonAssetLoader<Scenario>>()
+            .init_asset_loader::<RonAssetLoader<ArenaConfig>>()
+            .init_asset_loader::<RonAssetLoader<CreatureDef>>();
+    }
+}

@@ -1,0 +1,85 @@
+//! A scenario: which creatures, how many, the seed and the level policy.
+
+use super::{Validate, Validator};
+use crate::lod::LevelPolicy;
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+#[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Seeds the world's one RNG: same seed and files, same game.
+    pub seed: u64,
+    /// Length of a run when the command line does not say.
+    pub duration_s: f32,
+    /// Simulation ticks per second (the physics step); a multiple of `decision_hz`.
+    pub tick_hz: u32,
+    /// Steering decisions per second; the paper's frame rate is 30.
+    pub decision_hz: u32,
+    /// The arena file, relative to the assets folder.
+    pub arena: String,
+    pub creatures: Vec<CreatureGroup>,
+    pub level_policy: LevelPolicy,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CreatureGroup {
+    /// A creature kind: the file `creatures/<kind>.ron` under the assets folder.
+    pub kind: String,
+    pub count: u32,
+}
+
+impl Scenario {
+    pub fn creature_count(&self) -> u32 {
+        self.creatures.iter().map(|g| g.count).sum()
+    }
+
+    /// Simulation ticks per steering decision.
+    pub fn ticks_per_decision(&self) -> u32 {
+        self.tick_hz / self.decision_hz
+    }
+}
+
+/// Most creatures a scenario may hold.
+pub const MAX_CREATURES: u32 = 2_000_000;
+
+impl Validate for Scenario {
+    fn validate(&self, v: &mut Validator) {
+        v.positive("duration_s", self.duration_s);
+        v.require(
+            (30..=2000).contains(&self.tick_hz),
+            "tick_hz",
+            format!("must be between 30 and 2000, got {}", self.tick_hz),
+        );
+        v.require(
+            self.decision_hz > 0
+                && self.decision_hz <= self.tick_hz
+                && self.tick_hz % self.decision_hz == 0,
+            "decision_hz",
+            format!(
+                "must divide tick_hz ({}) evenly, got {}",
+                self.tick_hz, self.decision_hz
+            ),
+        );
+        v.require(!self.arena.is_empty(), "arena", "must name the arena file");
+        v.require(
+            !self.creatures.is_empty(),
+            "creatures",
+            "must list at least one group",
+        );
+        for (i, g) in self.creatures.iter().enumerate() {
+            v.require(
+                !g.kind.is_empty(),
+                &format!("creatures[{i}].kind"),
+                "must name a creature kind",
+            );
+        }
+        let total: u64 = self.creatures.iter().map(|g| u64::from(g.count)).sum();
+        v.require(
+            (1..=u64::from(MAX_CREATURES)).contains(&total),
+            "creatures",
+            format!("must hold between 1 and {MAX_CREATURES} creatures in all, got {total}"),
+        );
+    }
+}

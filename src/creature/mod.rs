@@ -1,0 +1,242 @@
+//! Creatures: the components every level of detail shares, spawning and respawning.
+
+pub mod steering;
+
+use bevy::prelude::*;
+use rand::RngExt;
+use std::ops::Index;
+
+use crate::WorldRng;
+use crate::config::{CreatureDef, SimConfig, SteeringConfig};
+use crate::lod::Lod;
+use crate::outcome::CollisionRecord;
+use std::collections::HashMap;
+
+/// A legged creature. Its level of detail is the [`Lod`] component beside it.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
+#[require(Lod, PlanarState, GaitPhase, DesiredVelocity, CollisionRecord)]
+pub struct Creature {
+    /// Index into [`KindTable`] (and [`SimConfig::kinds`]).
+    pub kind: usize,
+    /// Spawn number, unique over the run: a respawned creature is a new creature.
+    pub serial: u32,
+}
+
+/// The body's state on the ground plane, shared by every level (plane x, y = world x, z).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PlanarState {
+    pub position: Vec2,
+    pub velocity: Vec2,
+    /// Direction the body faces, radians from +x towards +y (world +z).
+    pub heading: f32,
+}
+
+/// Where the creature is in its hop cycle, advanced at every level so that a level switch
+/// can wait for the flight window (paper 3.4).
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct GaitPhase {
+    /// Fraction of the hop cycle since the last touchdown, in `[0, 1)`.
+    pub cycle: f32,
+    pub in_flight: bool,
+}
+
+/// The planar velocity steering asks for.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct DesiredVelocity(pub Vec2);
+
+/// Per-kind constants, derived once from the creature files.
+#[derive(Clone, Debug)]
+pub struct KindParams {
+    pub radius_m: f32,
+    pub mass_kg: f32,
+    pub top_speed_m_per_s: f32,
+    pub acceleration_limit_m_per_s2: f32,
+    /// Hop cycles per second.
+    pub cycles_per_s: f32,
+    /// Part of the cycle before lift-off.
+    pub stance_fraction: f32,
+    pub fall_impact_speed_m_per_s: f32,
+    pub collision_restitution: f32,
+    pub steering: SteeringConfig,
+}
+
+impl From<&CreatureDef> for KindParams {
+    fn from(d: &CreatureDef) -> Self {
+        Self {
+            radius_m: d.body.radius_m,
+            mass_kg: d.body.mass_kg,
+            top_speed_m_per_s: d.top_speed_m_per_s,
+            acceleration_limit_m_per_s2: d.acceleration_limit_m_per_s2,
+            cycles_per_s: 1.0 / d.hop_period_s,
+            stance_fraction: 1.0 - d.flight_fraction,
+            fall_impact_speed_m_per_s: d.fall_impact_speed_m_per_s,
+            collision_restitution: d.collision_restitution,
+            steering: d.steering.clone(),
+        }
+    }
+}
+
+/// The creature kinds of this run, indexed by [`Creature::kind`].
+#[derive(Resource, Clone, Debug)]
+pub struct KindTable(pub Vec<KindParams>);
+
+impl Index<usize> for KindTable {
+    type Output = KindParams;
+    fn index(&self, kind: usize) -> &KindParams {
+        &self.0[kind]
+    }
+}
+
+/// Hands out creature serials.
+#[derive(Resource, Debug, Default)]
+pub struct SerialCounter(pub u32);
+
+impl SerialCounter {
+    pub fn next(&mut self) -> u32 {
+        self.0 += 1;
+        self.0 - 1
+    }
+}
+
+/// Tries for a free spot before settling for the best one seen.
+const PLACEMENT_ATTEMPTS: usize = 24;
+
+/// A random spot in the court at least `wanted` clear by `clearance`, or the clearest of
+/// [`PLACEMENT_ATTEMPTS`] tries. `margin` keeps the spot off the walls.
+pub fn find_free_spot(
+    rng: &mut WorldRng,
+    half: Vec2,
+    margin: f32,
+    wanted: f32,
+    clearance: impl Fn(Vec2) -> f32,
+) -> Vec2 {
+    let inner = (half - Vec2::splat(margin)).max(Vec2::ZERO);
+    let mut best = (f32::NEG_INFINITY, Vec2::ZERO);
+    for _ in 0..PLACEMENT_ATTEMPTS {
+        let p = Vec2::new(
+            rng.0.random_range(-1.0..=1.0),
+            rng.0.random_range(-1.0..=1.0),
+        ) * inner;
+        let c = clearance(p);
+        if c >= wanted {
+            return p;
+        }
+        if c > best.0 {
+            best = (c, p);
+        }
+    }
+    best.1
+}
+
+/// What a new creature starts with, apart from where it stands.
+pub fn creature_bundle(
+    kind: usize,
+    serial: u32,
+    level: Lod,
+    position: Vec2,
+    rng: &mut WorldRng,
+) -> (Creature, Lod, PlanarState, GaitPhase) {
+    let heading = rng
+        .0
+        .random_range(-std::f32::consts::PI..std::f32::consts::PI);
+    let cycle = rng.0.random_range(0.0..1.0);
+    (
+        Creature { kind, serial },
+        level,
+        PlanarState {
+            position,
+            velocity: Vec2::ZERO,
+            heading,
+        },
+        GaitPhase {
+            cycle,
+            in_flight: false,
+        },
+    )
+}
+
+/// Who stands where while the scenario is being placed: a grid that grows one creature at
+/// a time, so placing N creatures costs O(N).
+struct Occupancy {
+    cell_m: f32,
+    cells: HashMap<(i32, i32), Vec<(Vec2, f32)>>,
+}
+
+impl Occupancy {
+    fn key(&self, p: Vec2) -> (i32, i32) {
+        let c = (p / self.cell_m).floor();
+        (c.x as i32, c.y as i32)
+    }
+
+    fn insert(&mut self, p: Vec2, radius: f32) {
+        let key = self.key(p);
+        self.cells.entry(key).or_default().push((p, radius));
+    }
+
+    /// Distance from `p` to the nearest rim within one cell's reach, else `cell_m`.
+    fn clearance(&self, p: Vec2) -> f32 {
+        let (x, y) = self.key(p);
+        let mut best = self.cell_m;
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                for (q, r) in self.cells.get(&(x + dx, y + dy)).into_iter().flatten() {
+                    best = best.min(q.distance(p) - r);
+                }
+            }
+        }
+        best
+    }
+}
+
+/// Places the scenario's creatures in free parts of the court.
+fn spawn_creatures(
+    mut commands: Commands,
+    config: Res<SimConfig>,
+    mut rng: ResMut<WorldRng>,
+    mut serials: ResMut<SerialCounter>,
+) {
+    let half = config.arena.half_extents();
+    let clear = config.arena.respawn_creature_clearance_m;
+    let biggest = config
+        .kinds
+        .iter()
+        .map(|k| k.body.radius_m)
+        .fold(0.0, f32::max);
+    let mut placed = Occupancy {
+        cell_m: 2.0 * biggest + clear,
+        cells: HashMap::new(),
+    };
+    let puck_keep_out = config.arena.puck.radius_m + config.arena.respawn_puck_clearance_m;
+    let level = config.scenario.level_policy.initial_level();
+    let mut batch = Vec::with_capacity(config.scenario.creature_count() as usize);
+    for group in &config.scenario.creatures {
+        let kind = config
+            .kind_index(&group.kind)
+            .expect("kinds are resolved when the config loads");
+        let radius = config.kinds[kind].body.radius_m;
+        for _ in 0..group.count {
+            // The puck starts at the centre.
+            let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {
+                placed.clearance(p).min(p.length() - puck_keep_out)
+            });
+            placed.insert(spot, radius);
+            batch.push(creature_bundle(kind, serials.next(), level, spot, &mut rng));
+        }
+    }
+    commands.spawn_batch(batch);
+}
+
+pub(super) fn plugin(app: &mut App) {
+    let kinds = KindTable(
+        app.world()
+            .resource::<SimConfig>()
+            .kinds
+            .iter()
+            .map(KindParams::from)
+            .collect(),
+    );
+    app.insert_resource(kinds)
+        .init_resource::<SerialCounter>()
+        .add_systems(Startup, spawn_creatures.after(crate::arena::spawn_arena));
+    steering::plugin(app);
+}

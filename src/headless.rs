@@ -1,0 +1,112 @@
+//! Running the simulation without a window: for the command line, the tests and the
+//! benchmarks. One `App::update` is one frame of `ticks_per_update` fixed ticks.
+
+use bevy::ecs::schedule::SingleThreadedExecutor;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use std::hash::{DefaultHasher, Hash, Hasher};
+use std::time::Instant;
+
+use crate::arena::PuckState;
+use crate::config::SimConfig;
+use crate::creature::{Creature, GaitPhase, PlanarState};
+use crate::outcome::{Summary, summarize};
+use crate::{SimClock, SimPlugin};
+
+/// A headless simulation: `MinimalPlugins` plus the core, driven in fixed ticks.
+pub struct HeadlessSim {
+    pub app: App,
+    ticks_per_update: u32,
+}
+
+impl HeadlessSim {
+    /// Builds the world; each [`HeadlessSim::advance_frame`] runs one steering decision's
+    /// worth of ticks (1/30 s with the default `decision_hz`).
+    pub fn new(config: SimConfig) -> Self {
+        let ticks_per_update = config.scenario.ticks_per_decision();
+        let mut app = App::new();
+        app.add_plugins(MinimalPlugins)
+            .add_plugins(SimPlugin { config })
+            .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
+        app.finish();
+        app.cleanup();
+        // Headless, every schedule is small: one thread runs them without wake-ups. Loops over
+        // many creatures still spread over the compute pool.
+        for (_, schedule) in app.world_mut().resource_mut::<Schedules>().iter_mut() {
+            schedule.set_executor(SingleThreadedExecutor::new());
+        }
+        // The first update runs Startup and sets the clocks going without a fixed tick.
+        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(0));
+        app.update();
+        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
+        Self {
+            app,
+            ticks_per_update,
+        }
+    }
+
+    pub fn clock(&self) -> SimClock {
+        *self.app.world().resource::<SimClock>()
+    }
+
+    /// Runs one frame: `ticks_per_decision` fixed ticks.
+    pub fn advance_frame(&mut self) {
+        self.app.update();
+    }
+
+    /// Runs whole frames until at least `seconds` have been simulated.
+    pub fn run_for(&mut self, seconds: f64) {
+        let frame = f64::from(self.ticks_per_update) * f64::from(self.clock().dt);
+        let frames = (seconds / frame - 1e-9).ceil().max(0.0) as u64;
+        for _ in 0..frames {
+            self.advance_frame();
+        }
+    }
+
+    pub fn summary(&mut self, wall_seconds: f64) -> Summary {
+        summarize(self.app.world_mut(), wall_seconds)
+    }
+
+    /// A digest of the simulated state, bit for bit: creatures by serial, and the puck.
+    pub fn state_digest(&mut self) -> u64 {
+        let world = self.app.world_mut();
+        let mut rows: Vec<(u32, [u32; 7], bool)> = world
+            .query::<(&Creature, &PlanarState, &GaitPhase)>()
+            .iter(world)
+            .map(|(c, s, g)| {
+                let bits = [
+                    s.position.x,
+                    s.position.y,
+                    s.velocity.x,
+                    s.velocity.y,
+                    s.heading,
+                    g.cycle,
+                    c.kind as f32,
+                ];
+                (c.serial, bits.map(f32::to_bits), g.in_flight)
+            })
+            .collect();
+        rows.sort_unstable_by_key(|r| r.0);
+        let puck = *world.resource::<PuckState>();
+        let mut h = DefaultHasher::new();
+        rows.hash(&mut h);
+        [
+            puck.position.x,
+            puck.position.y,
+            puck.velocity.x,
+            puck.velocity.y,
+        ]
+        .map(f32::to_bits)
+        .hash(&mut h);
+        h.finish()
+    }
+}
+
+/// Runs a scenario for `seconds` as fast as the machine allows and says what happened.
+pub fn run(config: SimConfig, seconds: f64) -> Summary {
+    let mut sim = HeadlessSim::new(config);
+    let start = Instant::now();
+    sim.run_for(seconds);
+    let wall = start.elapsed().as_secs_f64();
+    sim.summary(wall)
+}

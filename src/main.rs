@@ -1,0 +1,153 @@
+//! The `simlod` command line: the headless simulation and its measurements.
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use simlod::config::SimConfig;
+use simlod::lod::LevelPolicy;
+use simlod::outcome::Summary;
+use simlod::{bench, headless};
+
+#[derive(Parser)]
+#[command(
+    name = "simlod",
+    version,
+    about = "Simulation levels of detail for real-time animation (Carlson & Hodgins, GI '97)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a scenario without a window, as fast as the machine allows, and summarise it.
+    Run(RunArgs),
+    /// Measure the cost per creature per 1/30 s of motion and the most creatures at 30 fps.
+    Bench(BenchArgs),
+}
+
+#[derive(Args)]
+struct ScenarioArgs {
+    /// The scenario file.
+    #[arg(long, default_value = "assets/scenarios/default.ron")]
+    scenario: PathBuf,
+    /// The assets folder the scenario's arena and creature kinds are found in.
+    #[arg(long, default_value = "assets")]
+    assets: PathBuf,
+    /// Overrides the scenario's seed.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Overrides the scenario's level policy.
+    #[arg(long, value_enum)]
+    policy: Option<LevelPolicy>,
+}
+
+impl ScenarioArgs {
+    fn load(&self) -> Result<SimConfig, String> {
+        let mut config =
+            SimConfig::load(&self.scenario, &self.assets).map_err(|e| e.to_string())?;
+        if let Some(seed) = self.seed {
+            config.scenario.seed = seed;
+        }
+        if let Some(policy) = self.policy {
+            config.scenario.level_policy = policy;
+        }
+        Ok(config)
+    }
+}
+
+#[derive(Args)]
+struct RunArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Simulated seconds (default: the scenario's duration).
+    #[arg(long, value_parser = positive_seconds)]
+    seconds: Option<f64>,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// Print one JSON object per level, one per line.
+    #[arg(long)]
+    json: bool,
+    /// Fewer, shorter repetitions: a rough figure in seconds.
+    #[arg(long)]
+    quick: bool,
+}
+
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if v.is_finite() && v > 0.0 && v <= 1e6 {
+        Ok(v)
+    } else {
+        Err(format!("must be between 0 and 1e6 seconds, got {v}"))
+    }
+}
+
+fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
+    let join = |m: &std::collections::BTreeMap<&str, u64>| {
+        m.iter()
+            .map(|(k, v)| format!("{k} {v}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "simlod run: {}, seed {}, {} creatures",
+        args.scenario.scenario.display(),
+        s.seed,
+        s.creatures
+    );
+    println!(
+        "simulated {:.2} s in {:.3} s of wall time ({:.1}x real time); {} Hz ticks, {} Hz steering",
+        s.sim_seconds,
+        s.wall_seconds,
+        s.realtime_factor,
+        config.scenario.tick_hz,
+        config.scenario.decision_hz
+    );
+    println!("collisions: {}", join(&s.collisions));
+    println!(
+        "creatures that collided with the puck or a wall: {}",
+        s.creatures_collided
+    );
+    println!("falls: {}, respawns: {}", s.falls, s.respawns);
+    println!("creatures per level: {}", join(&s.levels));
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => args.scenario.load().map(|config| {
+            let seconds = args
+                .seconds
+                .unwrap_or(f64::from(config.scenario.duration_s));
+            let summary = headless::run(config.clone(), seconds);
+            if args.json {
+                println!(
+                    "{}",
+                    serde_json::to_string(&summary).expect("a summary serialises")
+                );
+            } else {
+                print_summary(&args, &summary, &config);
+            }
+        }),
+        Command::Bench(args) => args
+            .scenario
+            .load()
+            .map(|config| bench::run(&config, args.quick, args.json)),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+    }
+}

@@ -1,0 +1,9 @@
+//! Step: the model behind each level of detail.
+
+pub mod point_mass;
+
+use bevy::prelude::*;
+
+pub(super) fn plugin(app: &mut App) {
+    point_mass::plugin(app);
+}

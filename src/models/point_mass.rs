@@ -1,0 +1,142 @@
+//! The point-mass model (paper section 3.3): the body's position on the plane integrated
+//! with an acceleration limit and a top speed; the body faces its direction of travel; the
+//! leg is held at a constant angle, so there is nothing of it to compute.
+
+use bevy::prelude::*;
+
+use crate::config::SimConfig;
+use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
+use crate::lod::Lod;
+use crate::{SimClock, SimStage};
+
+/// Below this speed the heading is left where it was (no spinning in place).
+const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
+
+/// One tick of the planar point mass: velocity moves toward the desired one by at most the
+/// acceleration limit, then is clipped to the top speed.
+pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt: f32) {
+    let dv = (desired - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
+    state.velocity = (state.velocity + dv).clamp_length_max(kind.top_speed_m_per_s);
+    state.position += state.velocity * dt;
+    if state.velocity.length_squared() > HEADING_MIN_SPEED_M_PER_S * HEADING_MIN_SPEED_M_PER_S {
+        state.heading = state.velocity.to_angle();
+    }
+}
+
+/// Advances the hop cycle by time: stance first, then flight.
+pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, dt: f32) {
+    gait.cycle = (gait.cycle + dt * kind.cycles_per_s).fract();
+    gait.in_flight = gait.cycle >= kind.stance_fraction;
+}
+
+fn step_point_masses(
+    clock: Res<SimClock>,
+    config: Res<SimConfig>,
+    kinds: Res<KindTable>,
+    mut creatures: Query<(
+        &Creature,
+        &Lod,
+        &DesiredVelocity,
+        &mut PlanarState,
+        &mut GaitPhase,
+    )>,
+) {
+    let dt = clock.dt;
+    for_each_creature!(config.scenario.creature_count(), creatures, |(
+        creature,
+        lod,
+        desired,
+        mut state,
+        mut gait,
+    ): (
+        &Creature,
+        &Lod,
+        &DesiredVelocity,
+        Mut<PlanarState>,
+        Mut<GaitPhase>
+    )| {
+        if *lod == Lod::PointMass {
+            let kind = &kinds[creature.kind];
+            step_planar(&mut state, desired.0, kind, dt);
+            advance_gait(&mut gait, kind, dt);
+        }
+    });
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.add_systems(FixedUpdate, step_point_masses.in_set(SimStage::Step));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SteeringConfig;
+
+    fn kind() -> KindParams {
+        KindParams {
+            radius_m: 0.3,
+            mass_kg: 10.0,
+            top_speed_m_per_s: 3.0,
+            acceleration_limit_m_per_s2: 2.0,
+            cycles_per_s: 2.0,
+            stance_fraction: 0.4,
+            fall_impact_speed_m_per_s: 2.0,
+            collision_restitution: 0.0,
+            steering: SteeringConfig {
+                cruise_speed_m_per_s: 1.0,
+                wander_turn_rad_per_s: 0.0,
+                puck_alert_distance_m: 0.0,
+                puck_lookahead_s: 0.0,
+                puck_weight: 0.0,
+                wall_avoid_distance_m: 0.0,
+                wall_weight: 0.0,
+                separation_distance_m: 0.0,
+                separation_weight: 0.0,
+            },
+        }
+    }
+
+    #[test]
+    fn speed_rises_no_faster_than_the_acceleration_limit_and_stops_at_top_speed() {
+        let k = kind();
+        let mut s = PlanarState::default();
+        let dt = 1.0 / 240.0;
+        for _ in 0..240 {
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+        }
+        assert!(
+            (s.velocity.x - 2.0).abs() < 1e-3,
+            "after 1 s at 2 m/s^2: {}",
+            s.velocity.x
+        );
+        for _ in 0..480 {
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+        }
+        assert!((s.velocity.length() - 3.0).abs() < 1e-4);
+        assert_eq!(s.heading, 0.0);
+    }
+
+    #[test]
+    fn the_body_turns_to_face_its_direction_of_travel() {
+        let k = kind();
+        let mut s = PlanarState {
+            velocity: Vec2::new(0.0, 1.0),
+            ..default()
+        };
+        step_planar(&mut s, Vec2::new(0.0, 1.0), &k, 0.01);
+        assert!((s.heading - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+    }
+
+    #[test]
+    fn flight_follows_stance_in_each_hop_cycle() {
+        let k = kind();
+        let mut g = GaitPhase::default();
+        let mut flight_ticks = 0;
+        for _ in 0..1000 {
+            advance_gait(&mut g, &k, 0.001);
+            flight_ticks += g.in_flight as u32;
+        }
+        // 1 s at 2 cycles/s with 60 % flight.
+        assert!((flight_ticks as i32 - 600).abs() <= 2, "{flight_ticks}");
+    }
+}

@@ -1,0 +1,330 @@
+//! Observe and Outcome: collisions, falls, respawns and the counts the paper's experiments
+//! read (figure 10 counts the creatures that collided with the puck or a wall).
+//!
+//! What a collision does at the point-mass level, where there is no balance to lose: the
+//! bodies are pushed apart and the normal part of their relative velocity is removed (kept
+//! in part by the creature's `collision_restitution`). The puck is far heavier and is not
+//! slowed; it shoves the creature along. A creature falls when the normal speed of an impact
+//! exceeds its `fall_impact_speed_m_per_s`. A fallen creature is removed and a new one of
+//! its kind respawns in a free part of the court, so the count stays constant (section 3).
+//! Puck and wall contacts are checked every tick; contacts between creatures at each
+//! steering decision, through the spatial index.
+
+use bevy::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::sync::Mutex;
+
+use crate::arena::{Court, PuckState};
+use crate::config::SimConfig;
+use crate::creature::{
+    Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
+};
+use crate::lod::Lod;
+use crate::sense::NeighbourGrid;
+use crate::{SimClock, SimStage, WorldRng};
+
+/// What a creature can collide with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Obstacle {
+    Puck = 0,
+    Wall = 1,
+    Creature = 2,
+}
+
+impl Obstacle {
+    pub const ALL: [Obstacle; 3] = [Obstacle::Puck, Obstacle::Wall, Obstacle::Creature];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Obstacle::Puck => "puck",
+            Obstacle::Wall => "wall",
+            Obstacle::Creature => "creature",
+        }
+    }
+}
+
+/// One creature's collisions. A collision is the start of a contact.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct CollisionRecord {
+    /// In contact with each [`Obstacle`] at the last check.
+    pub touching: [bool; 3],
+    /// Collisions with each [`Obstacle`].
+    pub count: [u32; 3],
+}
+
+impl CollisionRecord {
+    /// The paper's outcome measure: did it collide with the puck or a wall?
+    pub fn hit_puck_or_wall(&self) -> bool {
+        self.count[Obstacle::Puck as usize] + self.count[Obstacle::Wall as usize] > 0
+    }
+
+    /// Notes whether the creature touches `obstacle` now; a new contact is a collision.
+    fn note(&mut self, obstacle: Obstacle, touching: bool) {
+        let i = obstacle as usize;
+        if touching && !self.touching[i] {
+            self.count[i] += 1;
+        }
+        self.touching[i] = touching;
+    }
+}
+
+/// Creatures that fell this tick; filled in parallel, emptied in serial order.
+#[derive(Resource, Default)]
+pub struct FallQueue(Mutex<Vec<(u32, Entity)>>);
+
+/// Counts kept for the whole run, beyond those of the creatures alive now.
+#[derive(Resource, Clone, Debug, Default)]
+pub struct Tally {
+    /// Collisions, by [`Obstacle`], of creatures already removed.
+    pub removed_collisions: [u64; 3],
+    /// Removed creatures that had collided with the puck or a wall.
+    pub removed_collided: u64,
+    pub falls: u64,
+    pub respawns: u64,
+}
+
+/// Resolves a contact along `normal` (pointing from the obstacle to the creature), where
+/// the obstacle moves at `other_velocity` and takes `share` of the push (0 = immovable).
+/// Returns the normal speed of the impact.
+fn resolve_contact(
+    state: &mut PlanarState,
+    normal: Vec2,
+    depth: f32,
+    other_velocity: Vec2,
+    share: f32,
+    restitution: f32,
+) -> f32 {
+    state.position += normal * depth * share;
+    let approach = (state.velocity - other_velocity).dot(normal);
+    if approach < 0.0 {
+        state.velocity -= normal * approach * (1.0 + restitution) * share;
+        -approach
+    } else {
+        0.0
+    }
+}
+
+/// Contacts of one point-mass creature this tick; returns the hardest impact's speed.
+fn collide_point_mass(
+    creature: &Creature,
+    state: &mut PlanarState,
+    record: &mut CollisionRecord,
+    kind: &KindParams,
+    puck: &PuckState,
+    court: &Court,
+    grid: Option<&NeighbourGrid>,
+) -> f32 {
+    let e = kind.collision_restitution;
+    let r = kind.radius_m;
+    let mut impact: f32 = 0.0;
+
+    if let Some(grid) = grid {
+        let mut touching = false;
+        grid.for_each_within(state.position, 2.0 * r + 2.0 * r.max(0.5), |n| {
+            let d = state.position - n.position;
+            let depth = r + n.radius - d.length();
+            if n.serial != creature.serial && depth > 0.0 {
+                touching = true;
+                let normal = d.try_normalize().unwrap_or(Vec2::X);
+                let share = n.mass / (n.mass + kind.mass_kg);
+                impact = impact.max(resolve_contact(state, normal, depth, n.velocity, share, e));
+            }
+        });
+        record.note(Obstacle::Creature, touching);
+    }
+
+    let d = state.position - puck.position;
+    let depth = puck.radius_m + r - d.length();
+    if depth > 0.0 {
+        let normal = d
+            .try_normalize()
+            .unwrap_or_else(|| puck.velocity.perp().normalize_or(Vec2::X));
+        impact = impact.max(resolve_contact(state, normal, depth, puck.velocity, 1.0, e));
+    }
+    record.note(Obstacle::Puck, depth > 0.0);
+
+    let half = court.half_extents - Vec2::splat(r);
+    let mut at_wall = false;
+    for axis in 0..2 {
+        let over = state.position[axis].abs() - half[axis];
+        if over >= 0.0 {
+            at_wall = true;
+            let mut normal = Vec2::ZERO;
+            normal[axis] = -state.position[axis].signum();
+            impact = impact.max(resolve_contact(state, normal, over, Vec2::ZERO, 1.0, e));
+            state.position[axis] = state.position[axis].clamp(-half[axis], half[axis]);
+        }
+    }
+    record.note(Obstacle::Wall, at_wall);
+    impact
+}
+
+fn detect_collisions(
+    clock: Res<SimClock>,
+    config: Res<SimConfig>,
+    kinds: Res<KindTable>,
+    puck: Res<PuckState>,
+    court: Res<Court>,
+    grid: Res<NeighbourGrid>,
+    falls: Res<FallQueue>,
+    mut creatures: Query<(
+        Entity,
+        &Creature,
+        &Lod,
+        &mut PlanarState,
+        &mut CollisionRecord,
+    )>,
+) {
+    let grid = clock.is_decision_tick().then_some(&*grid);
+    for_each_creature!(config.scenario.creature_count(), creatures, |(
+        entity,
+        creature,
+        lod,
+        mut state,
+        mut record,
+    ): (
+        Entity,
+        &Creature,
+        &Lod,
+        Mut<PlanarState>,
+        Mut<CollisionRecord>
+    )| {
+        if *lod != Lod::PointMass {
+            return;
+        }
+        let kind = &kinds[creature.kind];
+        let impact =
+            collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
+        if impact > kind.fall_impact_speed_m_per_s {
+            falls
+                .0
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .push((creature.serial, entity));
+        }
+    });
+}
+
+/// Removes the fallen and starts a new creature of the same kind in a free spot.
+#[allow(clippy::too_many_arguments)]
+fn respawn_fallen(
+    mut commands: Commands,
+    config: Res<SimConfig>,
+    puck: Res<PuckState>,
+    grid: Res<NeighbourGrid>,
+    falls: Res<FallQueue>,
+    mut tally: ResMut<Tally>,
+    mut rng: ResMut<WorldRng>,
+    mut serials: ResMut<SerialCounter>,
+    creatures: Query<(&Creature, &Lod, &CollisionRecord)>,
+) {
+    let mut fallen = std::mem::take(&mut *falls.0.lock().unwrap_or_else(|p| p.into_inner()));
+    if fallen.is_empty() {
+        return;
+    }
+    fallen.sort_unstable();
+    let half = config.arena.half_extents();
+    let clear = config.arena.respawn_creature_clearance_m;
+    let puck_keep_out = puck.radius_m + config.arena.respawn_puck_clearance_m;
+    for (_, entity) in fallen {
+        let Ok((creature, lod, record)) = creatures.get(entity) else {
+            continue;
+        };
+        for o in Obstacle::ALL {
+            tally.removed_collisions[o as usize] += u64::from(record.count[o as usize]);
+        }
+        tally.removed_collided += u64::from(record.hit_puck_or_wall());
+        tally.falls += 1;
+        tally.respawns += 1;
+        let radius = config.kinds[creature.kind].body.radius_m;
+        let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {
+            grid.clearance(p, radius + clear)
+                .min(p.distance(puck.position) - puck_keep_out)
+        });
+        commands.entity(entity).despawn();
+        commands.spawn(creature_bundle(
+            creature.kind,
+            serials.next(),
+            *lod,
+            spot,
+            &mut rng,
+        ));
+    }
+}
+
+fn advance_clock(mut clock: ResMut<SimClock>) {
+    clock.tick += 1;
+}
+
+/// What a run did, as the command line prints it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    pub seed: u64,
+    pub creatures: u64,
+    /// Collisions by obstacle (`puck`, `wall`, `creature`); a contact between two creatures
+    /// counts once for each.
+    pub collisions: BTreeMap<&'static str, u64>,
+    /// Creatures that collided with the puck or a wall (the paper's figure 10 measure).
+    pub creatures_collided: u64,
+    pub falls: u64,
+    pub respawns: u64,
+    /// Creatures at each level at the end.
+    pub levels: BTreeMap<&'static str, u64>,
+    pub sim_seconds: f64,
+    /// Wall-clock seconds; the only field that differs between identical runs.
+    pub wall_seconds: f64,
+    pub realtime_factor: f64,
+}
+
+/// Reads the counts out of a world (creatures alive now plus those removed).
+pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
+    let tally = world.resource::<Tally>().clone();
+    let clock = *world.resource::<SimClock>();
+    let seed = world.resource::<SimConfig>().scenario.seed;
+    let mut collisions = tally.removed_collisions;
+    let mut collided = tally.removed_collided;
+    let mut levels: BTreeMap<&'static str, u64> = Lod::ALL.iter().map(|l| (l.name(), 0)).collect();
+    let mut creatures = 0;
+    let mut query = world.query::<(&Lod, &CollisionRecord)>();
+    for (lod, record) in query.iter(world) {
+        creatures += 1;
+        *levels.entry(lod.name()).or_default() += 1;
+        for o in Obstacle::ALL {
+            collisions[o as usize] += u64::from(record.count[o as usize]);
+        }
+        collided += u64::from(record.hit_puck_or_wall());
+    }
+    let sim_seconds = clock.seconds();
+    Summary {
+        seed,
+        creatures,
+        collisions: Obstacle::ALL
+            .iter()
+            .map(|&o| (o.name(), collisions[o as usize]))
+            .collect(),
+        creatures_collided: collided,
+        falls: tally.falls,
+        respawns: tally.respawns,
+        levels,
+        sim_seconds,
+        wall_seconds,
+        realtime_factor: if wall_seconds > 0.0 {
+            sim_seconds / wall_seconds
+        } else {
+            f64::INFINITY
+        },
+    }
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<FallQueue>()
+        .init_resource::<Tally>()
+        .add_systems(FixedUpdate, detect_collisions.in_set(SimStage::Observe))
+        .add_systems(
+            FixedUpdate,
+            (respawn_fallen, advance_clock)
+                .chain()
+                .in_set(SimStage::Outcome),
+        );
+}

@@ -1,0 +1,211 @@
+//! Sense: the spatial index every neighbour query goes through, so that the cost per
+//! creature stays flat as the count grows (no all-pairs loop).
+
+use bevy::prelude::*;
+
+use crate::config::SimConfig;
+use crate::creature::{Creature, KindTable, PlanarState};
+use crate::{SimClock, SimStage};
+
+/// What a creature knows of a neighbour: a snapshot taken when the index was built.
+#[derive(Clone, Copy, Debug)]
+pub struct Neighbour {
+    pub position: Vec2,
+    pub velocity: Vec2,
+    pub radius: f32,
+    pub mass: f32,
+    /// The neighbour's [`Creature::serial`], so a creature can skip itself.
+    pub serial: u32,
+}
+
+/// A uniform grid over the court, rebuilt by counting sort at every steering decision.
+#[derive(Resource, Debug, Default)]
+pub struct NeighbourGrid {
+    min: Vec2,
+    inv_cell_m: f32,
+    cols: u32,
+    rows: u32,
+    /// `cell_start[c]..cell_start[c + 1]` are the entries of cell `c`.
+    cell_start: Vec<u32>,
+    entries: Vec<Neighbour>,
+    /// Scratch: each entry's cell, kept to avoid an allocation per rebuild.
+    cell_of_entry: Vec<u32>,
+    scratch: Vec<Neighbour>,
+}
+
+impl NeighbourGrid {
+    /// A grid covering the court (half extents `half`) with square cells of `cell_m`.
+    pub fn new(half: Vec2, cell_m: f32) -> Self {
+        let cols = ((2.0 * half.x / cell_m).ceil() as u32).max(1);
+        let rows = ((2.0 * half.y / cell_m).ceil() as u32).max(1);
+        Self {
+            min: -half,
+            inv_cell_m: 1.0 / cell_m,
+            cols,
+            rows,
+            cell_start: vec![0; (cols * rows + 1) as usize],
+            ..default()
+        }
+    }
+
+    fn cell_xy(&self, p: Vec2) -> (u32, u32) {
+        let c = ((p - self.min) * self.inv_cell_m).floor();
+        (
+            (c.x.max(0.0) as u32).min(self.cols - 1),
+            (c.y.max(0.0) as u32).min(self.rows - 1),
+        )
+    }
+
+    /// Replaces the contents with `items`.
+    pub fn rebuild(&mut self, items: impl Iterator<Item = Neighbour>) {
+        self.scratch.clear();
+        self.scratch.extend(items);
+        self.cell_of_entry.clear();
+        self.cell_start.fill(0);
+        for n in &self.scratch {
+            let (x, y) = self.cell_xy(n.position);
+            let c = y * self.cols + x;
+            self.cell_of_entry.push(c);
+            self.cell_start[c as usize + 1] += 1;
+        }
+        for c in 1..self.cell_start.len() {
+            self.cell_start[c] += self.cell_start[c - 1];
+        }
+        // Scatter in input order within each cell: deterministic.
+        let mut next = self.cell_start.clone();
+        self.entries.clear();
+        self.entries.resize(
+            self.scratch.len(),
+            self.scratch.first().copied().unwrap_or(EMPTY),
+        );
+        for (n, &c) in self.scratch.iter().zip(&self.cell_of_entry) {
+            let slot = &mut next[c as usize];
+            self.entries[*slot as usize] = *n;
+            *slot += 1;
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.entries.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// Calls `f` for every entry whose centre lies within `radius` of `p`.
+    pub fn for_each_within(&self, p: Vec2, radius: f32, mut f: impl FnMut(&Neighbour)) {
+        let (x0, y0) = self.cell_xy(p - Vec2::splat(radius));
+        let (x1, y1) = self.cell_xy(p + Vec2::splat(radius));
+        let r2 = radius * radius;
+        for y in y0..=y1 {
+            let row = y * self.cols;
+            let (a, b) = (
+                self.cell_start[(row + x0) as usize],
+                self.cell_start[(row + x1 + 1) as usize],
+            );
+            for n in &self.entries[a as usize..b as usize] {
+                if n.position.distance_squared(p) <= r2 {
+                    f(n);
+                }
+            }
+        }
+    }
+
+    /// Distance from `p` to the nearest entry's rim, looking no further than `radius`.
+    pub fn clearance(&self, p: Vec2, radius: f32) -> f32 {
+        let mut best = radius;
+        self.for_each_within(p, radius, |n| {
+            best = best.min(n.position.distance(p) - n.radius)
+        });
+        best
+    }
+}
+
+const EMPTY: Neighbour = Neighbour {
+    position: Vec2::ZERO,
+    velocity: Vec2::ZERO,
+    radius: 0.0,
+    mass: 0.0,
+    serial: 0,
+};
+
+/// Rebuilds the index at each steering decision.
+fn index_creatures(
+    clock: Res<SimClock>,
+    kinds: Res<KindTable>,
+    mut grid: ResMut<NeighbourGrid>,
+    creatures: Query<(&Creature, &PlanarState)>,
+) {
+    if !clock.is_decision_tick() {
+        return;
+    }
+    grid.rebuild(creatures.iter().map(|(c, s)| {
+        let k = &kinds[c.kind];
+        Neighbour {
+            position: s.position,
+            velocity: s.velocity,
+            radius: k.radius_m,
+            mass: k.mass_kg,
+            serial: c.serial,
+        }
+    }));
+}
+
+pub(super) fn plugin(app: &mut App) {
+    let config = app.world().resource::<SimConfig>();
+    let cell_m = config
+        .kinds
+        .iter()
+        .map(|k| k.steering.separation_distance_m.max(4.0 * k.body.radius_m))
+        .fold(0.5, f32::max);
+    let grid = NeighbourGrid::new(config.arena.half_extents(), cell_m);
+    app.insert_resource(grid)
+        .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(x: f32, y: f32, serial: u32) -> Neighbour {
+        Neighbour {
+            position: Vec2::new(x, y),
+            serial,
+            radius: 0.5,
+            ..EMPTY
+        }
+    }
+
+    #[test]
+    fn query_finds_exactly_the_entries_within_the_radius() {
+        let mut grid = NeighbourGrid::new(Vec2::new(10.0, 10.0), 1.5);
+        let items: Vec<_> = (0..400)
+            .map(|i| at((i % 20) as f32 - 9.5, (i / 20) as f32 - 9.5, i))
+            .collect();
+        grid.rebuild(items.iter().copied());
+        for p in [Vec2::ZERO, Vec2::new(9.9, -9.9), Vec2::new(-3.2, 4.7)] {
+            for r in [0.3, 1.0, 2.5, 6.0] {
+                let mut found: Vec<u32> = Vec::new();
+                grid.for_each_within(p, r, |n| found.push(n.serial));
+                found.sort();
+                let want: Vec<u32> = items
+                    .iter()
+                    .filter(|n| n.position.distance(p) <= r)
+                    .map(|n| n.serial)
+                    .collect();
+                assert_eq!(found, want, "p {p} r {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn points_outside_the_court_fall_into_edge_cells() {
+        let mut grid = NeighbourGrid::new(Vec2::new(2.0, 2.0), 1.0);
+        grid.rebuild([at(5.0, 5.0, 1)].into_iter());
+        let mut n = 0;
+        grid.for_each_within(Vec2::new(4.5, 4.5), 1.0, |_| n += 1);
+        assert_eq!(n, 1);
+        assert!((grid.clearance(Vec2::new(5.0, 3.0), 10.0) - 1.5).abs() < 1e-6);
+    }
+}
