@@ -70,6 +70,7 @@ pub struct SimClock {
     pub tick: u64,
     /// Seconds per tick (1 / `tick_hz`).
     pub dt: f32,
+    pub tick_hz: u32,
     /// Ticks per steering decision (`tick_hz / decision_hz`).
     pub ticks_per_decision: u32,
 }
@@ -86,7 +87,7 @@ impl SimClock {
     }
 
     pub fn seconds(&self) -> f64 {
-        self.tick as f64 * f64::from(self.dt)
+        self.tick as f64 / f64::from(self.tick_hz)
     }
 }
 

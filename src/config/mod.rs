@@ -129,7 +129,7 @@ fn known_kinds(assets_root: &Path) -> Vec<String> {
 }
 
 /// Registers the asset types and their loader with Bevy's asset server, when it is present.
-pub(super) fn plugin(app: &mut App) {
+pub fn plugin(app: &mut App) {
     if app.is_plugin_added::<bevy::asset::AssetPlugin>() {
         // All three share the `.ron` extension: the asset server picks the loader by the
         // asset type asked for.

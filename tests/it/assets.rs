@@ -1,0 +1,250 @@
+//! The asset files: the shipped ones load, broken ones give an error that names the file,
+//! the field and what is wrong, through both the file path and the asset server.
+
+use bevy::asset::{AssetPlugin, LoadState};
+use bevy::prelude::*;
+use std::path::{Path, PathBuf};
+
+use crate::support::*;
+use simlod::config::{ArenaConfig, ConfigError, CreatureDef, Scenario, SimConfig, load_file};
+
+/// A copy of the shipped assets in a scratch folder, with one file replaced.
+fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
+    let dir = scratch_dir(test);
+    for sub in ["", "creatures", "scenarios"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+        for entry in std::fs::read_dir(assets_root().join(sub))
+            .unwrap()
+            .flatten()
+        {
+            if entry.path().is_file() {
+                std::fs::copy(entry.path(), dir.join(sub).join(entry.file_name())).unwrap();
+            }
+        }
+    }
+    std::fs::write(dir.join(file), contents).unwrap();
+    dir
+}
+
+/// The shipped file with `from` replaced by `to`.
+fn edited(file: &str, from: &str, to: &str) -> Vec<u8> {
+    let text = std::fs::read_to_string(assets_root().join(file)).unwrap();
+    assert!(text.contains(from), "{file} has no {from:?}");
+    text.replacen(from, to, 1).into_bytes()
+}
+
+fn load_error(test: &str, file: &str, contents: &[u8]) -> ConfigError {
+    let root = assets_with(test, file, contents);
+    SimConfig::load(&root.join("scenarios/default.ron"), &root)
+        .expect_err("a broken file must not load")
+}
+
+fn assert_names(err: &ConfigError, file: &str, field: &str, words: &str) {
+    let text = err.to_string();
+    assert!(err.file.ends_with(file), "error should name {file}: {text}");
+    assert!(
+        text.contains(&format!("`{field}`")) || field.is_empty(),
+        "error should name field {field}: {text}"
+    );
+    assert!(
+        text.to_lowercase().contains(words),
+        "error should say {words:?}: {text}"
+    );
+}
+
+#[test]
+fn shipped_assets_load_and_validate() {
+    let config = default_config();
+    assert_eq!(config.kinds.len(), 2);
+    assert!(
+        config.arena.puck.speed_m_per_s
+            > config
+                .kinds
+                .iter()
+                .map(|k| k.top_speed_m_per_s)
+                .fold(0.0, f32::max)
+    );
+}
+
+#[test]
+fn a_missing_field_is_named() {
+    let err = load_error(
+        "missing_field",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "mass_kg: 10.0,", ""),
+    );
+    assert_names(&err, "creatures/hopper.ron", "mass_kg", "missing");
+}
+
+#[test]
+fn a_negative_mass_is_refused() {
+    let err = load_error(
+        "negative_mass",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "mass_kg: 10.0", "mass_kg: -10.0"),
+    );
+    assert_names(
+        &err,
+        "creatures/hopper.ron",
+        "body.mass_kg",
+        "greater than 0, got -10",
+    );
+}
+
+#[test]
+fn a_nan_is_refused() {
+    let err = load_error(
+        "nan",
+        "arena.ron",
+        &edited("arena.ron", "speed_m_per_s: 5.0", "speed_m_per_s: NaN"),
+    );
+    assert_names(&err, "arena.ron", "puck.speed_m_per_s", "finite");
+}
+
+#[test]
+fn an_unknown_creature_kind_is_named_with_the_known_ones() {
+    let err = load_error(
+        "unknown_kind",
+        "scenarios/default.ron",
+        &edited("scenarios/default.ron", "\"biped\"", "\"tripod\""),
+    );
+    assert_names(
+        &err,
+        "scenarios/default.ron",
+        "creatures[1].kind",
+        "unknown creature kind \"tripod\"",
+    );
+    assert!(err.to_string().contains("biped, hopper"), "{err}");
+}
+
+#[test]
+fn a_court_smaller_than_the_puck_is_refused() {
+    let err = load_error(
+        "small_court",
+        "arena.ron",
+        &edited("arena.ron", "court_width_m: 40.0", "court_width_m: 3.0"),
+    );
+    assert_names(
+        &err,
+        "arena.ron",
+        "puck.radius_m",
+        "does not fit in the court",
+    );
+}
+
+#[test]
+fn garbage_bytes_are_refused() {
+    let err = load_error(
+        "garbage",
+        "creatures/biped.ron",
+        &[0xff, 0xfe, 0x00, 0x13, 0x37, 0x80],
+    );
+    assert_names(&err, "creatures/biped.ron", "", "not a ron text file");
+    let err = load_error(
+        "garbage_text",
+        "creatures/biped.ron",
+        b"{{ this is not ron ]",
+    );
+    assert_names(&err, "creatures/biped.ron", "", "line 1");
+}
+
+#[test]
+fn an_empty_file_is_refused() {
+    let err = load_error("empty", "scenarios/default.ron", b"  \n");
+    assert_names(&err, "scenarios/default.ron", "", "empty");
+}
+
+#[test]
+fn a_misspelt_field_is_refused_not_ignored() {
+    let err = load_error(
+        "typo",
+        "arena.ron",
+        &edited("arena.ron", "wall_height_m", "wall_hieght_m"),
+    );
+    assert_names(&err, "arena.ron", "wall_hieght_m", "not a known field");
+}
+
+#[test]
+fn every_problem_in_a_file_is_reported_at_once() {
+    let bytes = edited(
+        "creatures/hopper.ron",
+        "top_speed_m_per_s: 3.0",
+        "top_speed_m_per_s: -3.0",
+    );
+    let bytes =
+        String::from_utf8(bytes)
+            .unwrap()
+            .replacen("hop_period_s: 0.5", "hop_period_s: 0.0", 1);
+    let err = load_error("two_problems", "creatures/hopper.ron", bytes.as_bytes());
+    let fields: Vec<&str> = err.problems.iter().map(|p| p.field.as_str()).collect();
+    assert!(
+        fields.contains(&"top_speed_m_per_s") && fields.contains(&"hop_period_s"),
+        "{err}"
+    );
+}
+
+/// Loads one asset through Bevy's asset server, as the game does.
+fn load_through_asset_server<A: Asset + Clone>(root: &Path, file: &str) -> Result<A, String> {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: root.to_string_lossy().into_owned(),
+            ..default()
+        },
+    ))
+    .add_plugins(simlod::config::plugin);
+    app.finish();
+    app.cleanup();
+    let handle: Handle<A> = app.world().resource::<AssetServer>().load(file.to_owned());
+    for _ in 0..2000 {
+        app.update();
+        match app.world().resource::<AssetServer>().load_state(&handle) {
+            LoadState::Loaded => {
+                return Ok(app
+                    .world()
+                    .resource::<Assets<A>>()
+                    .get(&handle)
+                    .unwrap()
+                    .clone());
+            }
+            LoadState::Failed(e) => return Err(e.to_string()),
+            _ => std::thread::sleep(std::time::Duration::from_millis(1)),
+        }
+    }
+    panic!("{file} neither loaded nor failed");
+}
+
+#[test]
+fn the_asset_server_loads_the_same_values_as_the_file_path() {
+    let root = assets_root();
+    let scenario: Scenario = load_through_asset_server(&root, "scenarios/default.ron").unwrap();
+    assert_eq!(
+        scenario,
+        load_file::<Scenario>(&root.join("scenarios/default.ron")).unwrap()
+    );
+    let arena: ArenaConfig = load_through_asset_server(&root, "arena.ron").unwrap();
+    assert_eq!(
+        arena,
+        load_file::<ArenaConfig>(&root.join("arena.ron")).unwrap()
+    );
+    let hopper: CreatureDef = load_through_asset_server(&root, "creatures/hopper.ron").unwrap();
+    assert_eq!(
+        hopper,
+        load_file::<CreatureDef>(&root.join("creatures/hopper.ron")).unwrap()
+    );
+}
+
+#[test]
+fn the_asset_server_reports_a_broken_file_with_the_same_message() {
+    let root = assets_with(
+        "asset_server_nan",
+        "arena.ron",
+        &edited("arena.ron", "mass_kg: 5000.0", "mass_kg: -1.0"),
+    );
+    let err = load_through_asset_server::<ArenaConfig>(&root, "arena.ron").unwrap_err();
+    assert!(
+        err.contains("`puck.mass_kg`") && err.contains("greater than 0"),
+        "{err}"
+    );
+}

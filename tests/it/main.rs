@@ -1,0 +1,9 @@
+//! The integration tests: one crate, a headless `App` with `MinimalPlugins` driven in fixed
+//! steps.
+
+mod assets;
+mod court;
+mod determinism;
+mod outcome;
+mod steering;
+mod support;

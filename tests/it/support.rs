@@ -1,0 +1,46 @@
+use bevy::prelude::*;
+use std::path::{Path, PathBuf};
+
+use simlod::config::SimConfig;
+use simlod::creature::{Creature, PlanarState};
+use simlod::headless::HeadlessSim;
+
+pub fn assets_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("assets")
+}
+
+pub fn default_config() -> SimConfig {
+    let root = assets_root();
+    SimConfig::load(&root.join("scenarios/default.ron"), &root).expect("the shipped assets load")
+}
+
+/// The default scenario with `count` hoppers.
+pub fn config_with_hoppers(count: u32) -> SimConfig {
+    let mut config = default_config();
+    config.scenario.creatures.retain(|g| g.kind == "hopper");
+    config.scenario.creatures[0].count = count;
+    config
+}
+
+/// Every creature's serial, kind and planar state.
+pub fn creatures(sim: &mut HeadlessSim) -> Vec<(Creature, PlanarState)> {
+    let world = sim.app.world_mut();
+    world
+        .query::<(&Creature, &PlanarState)>()
+        .iter(world)
+        .map(|(c, s)| (*c, *s))
+        .collect()
+}
+
+/// A scratch folder for one test's files.
+pub fn scratch_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+#[allow(dead_code)]
+pub fn vec2_in_court(p: Vec2, half: Vec2) -> bool {
+    p.x.abs() <= half.x && p.y.abs() <= half.y
+}
