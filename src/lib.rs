@@ -108,6 +108,7 @@ impl Plugin for SimPlugin {
             .insert_resource(SimClock {
                 tick: 0,
                 dt,
+                tick_hz: scenario.tick_hz,
                 ticks_per_decision: scenario.ticks_per_decision(),
             })
             .insert_resource(Time::<Fixed>::from_seconds(f64::from(dt)))
