@@ -1,6 +1,141 @@
 //! `simlod bench`: the paper's Table 1 unit (cost per creature per 1/30 s of motion) and
 //! figure 7's question (how many creatures hold 30 frames a second), headless.
+//!
+//! A bench world is the scenario scaled to a creature count: the same mix of kinds, the court
+//! grown to keep the scenario's density, so the work per creature (neighbours met, walls
+//! nearby) stays what the game has. One frame is 1/30 s of motion (one steering decision's
+//! ticks). Figures are medians over frames, measured in one process.
+
+use serde::Serialize;
+use std::time::Instant;
 
 use crate::config::SimConfig;
+use crate::headless::HeadlessSim;
+use crate::lod::{LevelPolicy, Lod};
 
-pub fn run(_config: &SimConfig, _quick: bool, _json: bool) {}
+/// Wall-clock budget of one frame at 30 fps.
+const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
+
+/// What `simlod bench --json` prints, one object per level.
+#[derive(Clone, Debug, Serialize)]
+pub struct LevelBench {
+    pub level: &'static str,
+    /// Median wall time per creature per 1/30 s of motion, at `reference_creatures`.
+    pub us_per_creature_per_frame: f64,
+    pub reference_creatures: u32,
+    /// Median wall time of a whole frame at `reference_creatures`.
+    pub frame_ms_median: f64,
+    /// The most creatures whose median frame fits in 1/30 s (within the search's 3 %).
+    pub max_creatures_30fps: u32,
+    /// Frames measured per median.
+    pub frames: usize,
+}
+
+/// The scenario with `count` creatures of the same mix, in a court grown to the same density.
+pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig {
+    let mut c = config.clone();
+    let base = config.scenario.creature_count();
+    let mut left = count;
+    for (i, g) in c.scenario.creatures.iter_mut().enumerate().rev() {
+        g.count = if i == 0 {
+            left
+        } else {
+            (u64::from(g.count) * u64::from(count) / u64::from(base)) as u32
+        };
+        left -= g.count;
+    }
+    c.scenario.creatures.retain(|g| g.count > 0);
+    let grow = (count as f32 / base as f32).max(1.0).sqrt();
+    c.arena.court_length_m *= grow;
+    c.arena.court_width_m *= grow;
+    c.scenario.level_policy = policy;
+    c
+}
+
+/// Median frame time in seconds of `config`, after a warm-up.
+pub fn median_frame_seconds(config: SimConfig, warmup: usize, frames: usize) -> f64 {
+    let mut sim = HeadlessSim::new(config);
+    for _ in 0..warmup {
+        sim.advance_frame();
+    }
+    let mut times: Vec<f64> = (0..frames)
+        .map(|_| {
+            let start = Instant::now();
+            sim.advance_frame();
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+struct Effort {
+    reference: u32,
+    warmup: usize,
+    frames: usize,
+    search_steps: u32,
+}
+
+fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Effort) -> LevelBench {
+    let frame_s = median_frame_seconds(scaled(config, effort.reference, policy), effort.warmup, effort.frames);
+    let fits =
+        |n: u32| median_frame_seconds(scaled(config, n, policy), effort.warmup / 2, effort.frames) <= FRAME_BUDGET_S;
+    // Double until a count misses the budget, then halve the gap.
+    let (mut good, mut bad) = (0u32, 1000u32);
+    while bad < crate::config::MAX_CREATURES && fits(bad) {
+        good = bad;
+        bad = (bad * 2).min(crate::config::MAX_CREATURES);
+    }
+    for _ in 0..effort.search_steps {
+        if bad - good <= good / 32 + 1 {
+            break;
+        }
+        let mid = good + (bad - good) / 2;
+        if fits(mid) { good = mid } else { bad = mid }
+    }
+    LevelBench {
+        level: level.name(),
+        us_per_creature_per_frame: frame_s * 1e6 / f64::from(effort.reference),
+        reference_creatures: effort.reference,
+        frame_ms_median: frame_s * 1e3,
+        max_creatures_30fps: good,
+        frames: effort.frames,
+    }
+}
+
+/// Runs the benchmark for every level and prints it.
+pub fn run(config: &SimConfig, quick: bool, json: bool) {
+    let effort = if quick {
+        Effort {
+            reference: 2_000,
+            warmup: 10,
+            frames: 15,
+            search_steps: 3,
+        }
+    } else {
+        Effort {
+            reference: 10_000,
+            warmup: 30,
+            frames: 45,
+            search_steps: 6,
+        }
+    };
+    let levels = [(Lod::PointMass, LevelPolicy::AllPointMass)];
+    if !json {
+        println!(
+            "simlod bench: median of {} frames of 1/30 s; cost per creature at {} creatures; court scaled to the scenario's density",
+            effort.frames, effort.reference
+        );
+    }
+    for (level, policy) in levels {
+        let b = bench_level(config, level, policy, &effort);
+        if json {
+            println!("{}", serde_json::to_string(&b).expect("a bench result serialises"));
+        } else {
+            println!(
+                "{:<11} {:>9.3} us per creature per frame ({:.2} ms a frame at {}); most creatures at 30 fps: {}",
+                b.level, b.us_per_creature_per_frame, b.frame_ms_median, b.reference_creatures, b.max_creatures_30fps
+            );
+        }
+    }
+}

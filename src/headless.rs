@@ -25,9 +25,11 @@ impl HeadlessSim {
     pub fn new(config: SimConfig) -> Self {
         let ticks_per_update = config.scenario.ticks_per_decision();
         let mut app = App::new();
-        app.add_plugins(MinimalPlugins)
-            .add_plugins(SimPlugin { config })
-            .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
+        app.add_plugins(MinimalPlugins.set(TaskPoolPlugin {
+            task_pool_options: compute_on_every_core(),
+        }))
+        .add_plugins(SimPlugin { config })
+        .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
         app.finish();
         app.cleanup();
         // Headless, every schedule is small: one thread runs them without wake-ups. Loops over
@@ -39,10 +41,7 @@ impl HeadlessSim {
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(0));
         app.update();
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
-        Self {
-            app,
-            ticks_per_update,
-        }
+        Self { app, ticks_per_update }
     }
 
     pub fn clock(&self) -> SimClock {
@@ -70,7 +69,7 @@ impl HeadlessSim {
     /// A digest of the simulated state, bit for bit: creatures by serial, and the puck.
     pub fn state_digest(&mut self) -> u64 {
         let world = self.app.world_mut();
-        let mut rows: Vec<(u32, [u32; 7], bool)> = world
+        let mut rows: Vec<(u32, [u32; 8], bool)> = world
             .query::<(&Creature, &PlanarState, &GaitPhase)>()
             .iter(world)
             .map(|(c, s, g)| {
@@ -79,7 +78,8 @@ impl HeadlessSim {
                     s.position.y,
                     s.velocity.x,
                     s.velocity.y,
-                    s.heading,
+                    s.heading.x,
+                    s.heading.y,
                     g.cycle,
                     c.kind as f32,
                 ];
@@ -90,16 +90,20 @@ impl HeadlessSim {
         let puck = *world.resource::<PuckState>();
         let mut h = DefaultHasher::new();
         rows.hash(&mut h);
-        [
-            puck.position.x,
-            puck.position.y,
-            puck.velocity.x,
-            puck.velocity.y,
-        ]
-        .map(f32::to_bits)
-        .hash(&mut h);
+        [puck.position.x, puck.position.y, puck.velocity.x, puck.velocity.y]
+            .map(f32::to_bits)
+            .hash(&mut h);
         h.finish()
     }
+}
+
+/// Bevy's default gives compute a share of the cores, which on two cores is one thread, and
+/// loops over creatures then never run in parallel. Headless there is nothing else to run.
+fn compute_on_every_core() -> TaskPoolOptions {
+    let cores = bevy::tasks::available_parallelism();
+    let mut options = TaskPoolOptions::default();
+    options.compute.min_threads = cores;
+    options
 }
 
 /// Runs a scenario for `seconds` as fast as the machine allows and says what happened.

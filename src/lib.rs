@@ -78,7 +78,7 @@ pub struct SimClock {
 impl SimClock {
     /// Steering and the spatial index run on these ticks only (the decision rate).
     pub fn is_decision_tick(&self) -> bool {
-        self.tick % u64::from(self.ticks_per_decision) == 0
+        self.tick.is_multiple_of(u64::from(self.ticks_per_decision))
     }
 
     /// Index of the current steering decision.

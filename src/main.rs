@@ -46,8 +46,7 @@ struct ScenarioArgs {
 
 impl ScenarioArgs {
     fn load(&self) -> Result<SimConfig, String> {
-        let mut config =
-            SimConfig::load(&self.scenario, &self.assets).map_err(|e| e.to_string())?;
+        let mut config = SimConfig::load(&self.scenario, &self.assets).map_err(|e| e.to_string())?;
         if let Some(seed) = self.seed {
             config.scenario.seed = seed;
         }
@@ -93,10 +92,7 @@ fn positive_seconds(s: &str) -> Result<f64, String> {
 
 fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
     let join = |m: &std::collections::BTreeMap<&str, u64>| {
-        m.iter()
-            .map(|(k, v)| format!("{k} {v}"))
-            .collect::<Vec<_>>()
-            .join(", ")
+        m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
     };
     println!(
         "simlod run: {}, seed {}, {} creatures",
@@ -106,11 +102,7 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
     );
     println!(
         "simulated {:.2} s in {:.3} s of wall time ({:.1}x real time); {} Hz ticks, {} Hz steering",
-        s.sim_seconds,
-        s.wall_seconds,
-        s.realtime_factor,
-        config.scenario.tick_hz,
-        config.scenario.decision_hz
+        s.sim_seconds, s.wall_seconds, s.realtime_factor, config.scenario.tick_hz, config.scenario.decision_hz
     );
     println!("collisions: {}", join(&s.collisions));
     println!(
@@ -125,15 +117,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(args) => args.scenario.load().map(|config| {
-            let seconds = args
-                .seconds
-                .unwrap_or(f64::from(config.scenario.duration_s));
+            let seconds = args.seconds.unwrap_or(f64::from(config.scenario.duration_s));
             let summary = headless::run(config.clone(), seconds);
             if args.json {
-                println!(
-                    "{}",
-                    serde_json::to_string(&summary).expect("a summary serialises")
-                );
+                println!("{}", serde_json::to_string(&summary).expect("a summary serialises"));
             } else {
                 print_summary(&args, &summary, &config);
             }

@@ -41,11 +41,7 @@ fn launch_direction(rng: &mut WorldRng) -> Vec2 {
     Vec2::from_angle(angle)
 }
 
-pub(crate) fn spawn_arena(
-    mut commands: Commands,
-    config: Res<SimConfig>,
-    mut rng: ResMut<WorldRng>,
-) {
+pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let arena = &config.arena;
     let half = arena.half_extents();
     let (t, h) = (arena.wall_thickness_m, arena.wall_height_m);

@@ -46,10 +46,7 @@ impl Validate for ArenaConfig {
         v.positive("wall_height_m", self.wall_height_m);
         v.positive("wall_thickness_m", self.wall_thickness_m);
         v.non_negative("respawn_puck_clearance_m", self.respawn_puck_clearance_m);
-        v.non_negative(
-            "respawn_creature_clearance_m",
-            self.respawn_creature_clearance_m,
-        );
+        v.non_negative("respawn_creature_clearance_m", self.respawn_creature_clearance_m);
         v.nested("puck", |v| {
             v.positive("radius_m", self.puck.radius_m);
             v.positive("height_m", self.puck.height_m);
@@ -58,8 +55,7 @@ impl Validate for ArenaConfig {
         });
         let smallest_side = self.court_length_m.min(self.court_width_m);
         v.require(
-            !(smallest_side > 0.0 && self.puck.radius_m > 0.0)
-                || smallest_side > 2.0 * self.puck.radius_m,
+            !(smallest_side > 0.0 && self.puck.radius_m > 0.0) || smallest_side > 2.0 * self.puck.radius_m,
             "puck.radius_m",
             format!(
                 "the puck (diameter {} m) does not fit in the court ({} x {} m)",

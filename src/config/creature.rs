@@ -79,19 +79,11 @@ impl Validate for CreatureDef {
             v.positive("mass_kg", self.body.mass_kg);
         });
         v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
-        v.positive(
-            "acceleration_limit_m_per_s2",
-            self.acceleration_limit_m_per_s2,
-        );
+        v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
         v.positive("hop_period_s", self.hop_period_s);
         v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
         v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);
-        v.within(
-            "collision_restitution",
-            self.collision_restitution,
-            0.0,
-            1.0,
-        );
+        v.within("collision_restitution", self.collision_restitution, 0.0, 1.0);
         let s = &self.steering;
         v.nested("steering", |v| {
             v.non_negative("cruise_speed_m_per_s", s.cruise_speed_m_per_s);
@@ -104,12 +96,9 @@ impl Validate for CreatureDef {
             v.non_negative("separation_distance_m", s.separation_distance_m);
             v.non_negative("separation_weight", s.separation_weight);
             v.require(
-                !(s.cruise_speed_m_per_s > self.top_speed_m_per_s),
+                s.cruise_speed_m_per_s.is_nan() || s.cruise_speed_m_per_s <= self.top_speed_m_per_s,
                 "cruise_speed_m_per_s",
-                format!(
-                    "must not exceed top_speed_m_per_s ({})",
-                    self.top_speed_m_per_s
-                ),
+                format!("must not exceed top_speed_m_per_s ({})", self.top_speed_m_per_s),
             );
         });
     }

@@ -8,10 +8,7 @@ use std::marker::PhantomData;
 use std::path::Path;
 
 /// Parses RON bytes into `T` and validates it; every error names `file`.
-pub fn parse_ron<T: DeserializeOwned + Validate>(
-    bytes: &[u8],
-    file: &Path,
-) -> Result<T, ConfigError> {
+pub fn parse_ron<T: DeserializeOwned + Validate>(bytes: &[u8], file: &Path) -> Result<T, ConfigError> {
     if bytes.iter().all(u8::is_ascii_whitespace) {
         return Err(ConfigError::one(file, "", "the file is empty"));
     }
@@ -19,10 +16,7 @@ pub fn parse_ron<T: DeserializeOwned + Validate>(
         ConfigError::one(
             file,
             "",
-            format!(
-                "not a RON text file: invalid UTF-8 at byte {}",
-                e.valid_up_to()
-            ),
+            format!("not a RON text file: invalid UTF-8 at byte {}", e.valid_up_to()),
         )
     })?;
     let value: T = ron::from_str(text).map_err(|e| parse_error(file, e))?;
@@ -34,8 +28,7 @@ pub fn parse_ron<T: DeserializeOwned + Validate>(
 
 /// Reads and parses one asset file by path (the headless CLI and the tests).
 pub fn load_file<T: DeserializeOwned + Validate>(file: &Path) -> Result<T, ConfigError> {
-    let bytes = std::fs::read(file)
-        .map_err(|e| ConfigError::one(file, "", format!("cannot read the file: {e}")))?;
+    let bytes = std::fs::read(file).map_err(|e| ConfigError::one(file, "", format!("cannot read the file: {e}")))?;
     parse_ron(&bytes, file)
 }
 
@@ -56,10 +49,7 @@ fn parse_error(file: &Path, e: ron::error::SpannedError) -> ConfigError {
                 expected.join(", ")
             )
         }
-        code => format!(
-            "line {}, column {}: {code}",
-            e.position.line, e.position.col
-        ),
+        code => format!("line {}, column {}: {code}", e.position.line, e.position.col),
     };
     ConfigError::one(file, field, message)
 }
@@ -72,9 +62,7 @@ pub struct RonAssetLoader<T> {
 
 impl<T> Default for RonAssetLoader<T> {
     fn default() -> Self {
-        Self {
-            _asset: PhantomData,
-        }
+        Self { _asset: PhantomData }
     }
 }
 

@@ -13,7 +13,7 @@ mod validate;
 pub use arena::{ArenaConfig, PuckConfig};
 pub use creature::{BodyConfig, CreatureDef, SteeringConfig};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
-pub use scenario::{CreatureGroup, Scenario};
+pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};
 
 use bevy::prelude::*;
@@ -58,19 +58,12 @@ impl SimConfig {
                 return Err(ConfigError::one(
                     &path,
                     "name",
-                    format!(
-                        "is {:?} but the file is named for kind {:?}",
-                        def.name, group.kind
-                    ),
+                    format!("is {:?} but the file is named for kind {:?}", def.name, group.kind),
                 ));
             }
             kinds.push(def);
         }
-        let config = Self {
-            scenario,
-            arena,
-            kinds,
-        };
+        let config = Self { scenario, arena, kinds };
         config.check_fit(scenario_path)?;
         Ok(config)
     }
@@ -82,11 +75,7 @@ impl SimConfig {
 
     /// Checks that span files: every creature fits in the court beside the puck.
     fn check_fit(&self, scenario_path: &Path) -> Result<(), ConfigError> {
-        let biggest = self
-            .kinds
-            .iter()
-            .map(|k| k.body.radius_m)
-            .fold(0.0, f32::max);
+        let biggest = self.kinds.iter().map(|k| k.body.radius_m).fold(0.0, f32::max);
         let half = self.arena.half_extents();
         if half.min_element() <= self.arena.puck.radius_m + 2.0 * biggest {
             return Err(ConfigError::one(
@@ -94,10 +83,7 @@ impl SimConfig {
                 "arena",
                 format!(
                     "the court ({} x {} m) leaves no room beside the puck (radius {} m) for a creature (radius {} m)",
-                    self.arena.court_length_m,
-                    self.arena.court_width_m,
-                    self.arena.puck.radius_m,
-                    biggest
+                    self.arena.court_length_m, self.arena.court_width_m, self.arena.puck.radius_m, biggest
                 ),
             ));
         }

@@ -53,9 +53,7 @@ impl Validate for Scenario {
             format!("must be between 30 and 2000, got {}", self.tick_hz),
         );
         v.require(
-            self.decision_hz > 0
-                && self.decision_hz <= self.tick_hz
-                && self.tick_hz % self.decision_hz == 0,
+            self.decision_hz > 0 && self.decision_hz <= self.tick_hz && self.tick_hz.is_multiple_of(self.decision_hz),
             "decision_hz",
             format!(
                 "must divide tick_hz ({}) evenly, got {}",
@@ -63,11 +61,7 @@ impl Validate for Scenario {
             ),
         );
         v.require(!self.arena.is_empty(), "arena", "must name the arena file");
-        v.require(
-            !self.creatures.is_empty(),
-            "creatures",
-            "must list at least one group",
-        );
+        v.require(!self.creatures.is_empty(), "creatures", "must list at least one group");
         for (i, g) in self.creatures.iter().enumerate() {
             v.require(
                 !g.kind.is_empty(),

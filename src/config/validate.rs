@@ -111,10 +111,7 @@ impl Validator {
         if !value.is_finite() {
             self.fail(field, format!("must be a finite number, got {value}"));
         } else if !(min..=max).contains(&value) {
-            self.fail(
-                field,
-                format!("must be between {min} and {max}, got {value}"),
-            );
+            self.fail(field, format!("must be between {min} and {max}, got {value}"));
         }
     }
 

@@ -23,12 +23,29 @@ pub struct Creature {
 }
 
 /// The body's state on the ground plane, shared by every level (plane x, y = world x, z).
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct PlanarState {
     pub position: Vec2,
     pub velocity: Vec2,
-    /// Direction the body faces, radians from +x towards +y (world +z).
-    pub heading: f32,
+    /// Direction the body faces: a unit vector (an angle would cost an `atan2` per tick).
+    pub heading: Vec2,
+}
+
+impl Default for PlanarState {
+    fn default() -> Self {
+        Self {
+            position: Vec2::ZERO,
+            velocity: Vec2::ZERO,
+            heading: Vec2::X,
+        }
+    }
+}
+
+impl PlanarState {
+    /// The heading as an angle, radians from +x towards +y (world +z).
+    pub fn heading_angle(&self) -> f32 {
+        self.heading.to_angle()
+    }
 }
 
 /// Where the creature is in its hop cycle, advanced at every level so that a level switch
@@ -92,7 +109,7 @@ impl Index<usize> for KindTable {
 pub struct SerialCounter(pub u32);
 
 impl SerialCounter {
-    pub fn next(&mut self) -> u32 {
+    pub fn take(&mut self) -> u32 {
         self.0 += 1;
         self.0 - 1
     }
@@ -113,10 +130,7 @@ pub fn find_free_spot(
     let inner = (half - Vec2::splat(margin)).max(Vec2::ZERO);
     let mut best = (f32::NEG_INFINITY, Vec2::ZERO);
     for _ in 0..PLACEMENT_ATTEMPTS {
-        let p = Vec2::new(
-            rng.0.random_range(-1.0..=1.0),
-            rng.0.random_range(-1.0..=1.0),
-        ) * inner;
+        let p = Vec2::new(rng.0.random_range(-1.0..=1.0), rng.0.random_range(-1.0..=1.0)) * inner;
         let c = clearance(p);
         if c >= wanted {
             return p;
@@ -136,9 +150,7 @@ pub fn creature_bundle(
     position: Vec2,
     rng: &mut WorldRng,
 ) -> (Creature, Lod, PlanarState, GaitPhase) {
-    let heading = rng
-        .0
-        .random_range(-std::f32::consts::PI..std::f32::consts::PI);
+    let heading = Vec2::from_angle(rng.0.random_range(-std::f32::consts::PI..std::f32::consts::PI));
     let cycle = rng.0.random_range(0.0..1.0);
     (
         Creature { kind, serial },
@@ -197,11 +209,7 @@ fn spawn_creatures(
 ) {
     let half = config.arena.half_extents();
     let clear = config.arena.respawn_creature_clearance_m;
-    let biggest = config
-        .kinds
-        .iter()
-        .map(|k| k.body.radius_m)
-        .fold(0.0, f32::max);
+    let biggest = config.kinds.iter().map(|k| k.body.radius_m).fold(0.0, f32::max);
     let mut placed = Occupancy {
         cell_m: 2.0 * biggest + clear,
         cells: HashMap::new(),
@@ -220,7 +228,7 @@ fn spawn_creatures(
                 placed.clearance(p).min(p.length() - puck_keep_out)
             });
             placed.insert(spot, radius);
-            batch.push(creature_bundle(kind, serials.next(), level, spot, &mut rng));
+            batch.push(creature_bundle(kind, serials.take(), level, spot, &mut rng));
         }
     }
     commands.spawn_batch(batch);

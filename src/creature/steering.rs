@@ -46,21 +46,15 @@ pub struct Surroundings<'a> {
 }
 
 /// The velocity a creature wants, given where it is and what is around it.
-pub fn desired_velocity(
-    creature: &Creature,
-    state: &PlanarState,
-    kind: &KindParams,
-    around: &Surroundings,
-) -> Vec2 {
+pub fn desired_velocity(creature: &Creature, state: &PlanarState, kind: &KindParams, around: &Surroundings) -> Vec2 {
     let s = &kind.steering;
     let p = state.position;
     let top = kind.top_speed_m_per_s;
 
     // Wander: keep going the way it faces, drifting a little.
-    let turn = wander_noise(around.seed, creature.serial, around.decision)
-        * s.wander_turn_rad_per_s
-        * around.decision_dt;
-    let mut desired = Vec2::from_angle(state.heading + turn) * s.cruise_speed_m_per_s;
+    let turn =
+        wander_noise(around.seed, creature.serial, around.decision) * s.wander_turn_rad_per_s * around.decision_dt;
+    let mut desired = Vec2::from_angle(turn).rotate(state.heading) * s.cruise_speed_m_per_s;
 
     // Flee the puck: away from the nearest point of its path over the look-ahead, harder
     // the closer. Dodging sideways out of its path beats outrunning it.
@@ -79,17 +73,15 @@ pub fn desired_velocity(
     // Keep apart from neighbours.
     if s.separation_distance_m > 0.0 {
         let mut push = Vec2::ZERO;
-        around
-            .grid
-            .for_each_within(p, s.separation_distance_m, |n| {
-                if n.serial != creature.serial {
-                    let d = p - n.position;
-                    let len = d.length();
-                    if len > 1e-4 {
-                        push += d / len * (1.0 - len / s.separation_distance_m);
-                    }
+        around.grid.for_each_within(p, s.separation_distance_m, |n| {
+            if n.serial != creature.serial {
+                let d = p - n.position;
+                let len = d.length();
+                if len > 1e-4 {
+                    push += d / len * (1.0 - len / s.separation_distance_m);
                 }
-            });
+            }
+        });
         desired += push * (top * s.separation_weight);
     }
 
@@ -167,10 +159,7 @@ mod tests {
     #[test]
     fn nearest_point_on_a_segment_is_clamped_to_its_ends() {
         let (a, b) = (Vec2::ZERO, Vec2::new(10.0, 0.0));
-        assert_eq!(
-            nearest_on_segment(Vec2::new(5.0, 3.0), a, b),
-            Vec2::new(5.0, 0.0)
-        );
+        assert_eq!(nearest_on_segment(Vec2::new(5.0, 3.0), a, b), Vec2::new(5.0, 0.0));
         assert_eq!(nearest_on_segment(Vec2::new(-5.0, 3.0), a, b), a);
         assert_eq!(nearest_on_segment(Vec2::new(15.0, 3.0), a, b), b);
         assert_eq!(nearest_on_segment(Vec2::ONE, a, a), a);

@@ -8,20 +8,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The level of detail a creature is simulated at.
-#[derive(
-    Component,
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    Serialize,
-    Deserialize,
-)]
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum Lod {
     /// A point mass on the plane with an acceleration limit; the leg held at a constant
     /// angle (section 3.3).

@@ -18,8 +18,9 @@ pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt
     let dv = (desired - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
     state.velocity = (state.velocity + dv).clamp_length_max(kind.top_speed_m_per_s);
     state.position += state.velocity * dt;
-    if state.velocity.length_squared() > HEADING_MIN_SPEED_M_PER_S * HEADING_MIN_SPEED_M_PER_S {
-        state.heading = state.velocity.to_angle();
+    let speed = state.velocity.length();
+    if speed > HEADING_MIN_SPEED_M_PER_S {
+        state.heading = state.velocity / speed;
     }
 }
 
@@ -33,13 +34,7 @@ fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
-    mut creatures: Query<(
-        &Creature,
-        &Lod,
-        &DesiredVelocity,
-        &mut PlanarState,
-        &mut GaitPhase,
-    )>,
+    mut creatures: Query<(&Creature, &Lod, &DesiredVelocity, &mut PlanarState, &mut GaitPhase)>,
 ) {
     let dt = clock.dt;
     for_each_creature!(config.scenario.creature_count(), creatures, |(
@@ -113,7 +108,7 @@ mod tests {
             step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
         }
         assert!((s.velocity.length() - 3.0).abs() < 1e-4);
-        assert_eq!(s.heading, 0.0);
+        assert_eq!(s.heading, Vec2::X);
     }
 
     #[test]
@@ -124,7 +119,7 @@ mod tests {
             ..default()
         };
         step_planar(&mut s, Vec2::new(0.0, 1.0), &k, 0.01);
-        assert!((s.heading - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!((s.heading_angle() - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
     }
 
     #[test]

@@ -17,9 +17,7 @@ use std::sync::Mutex;
 
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
-use crate::creature::{
-    Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
-};
+use crate::creature::{Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot};
 use crate::lod::Lod;
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, WorldRng};
@@ -168,13 +166,7 @@ fn detect_collisions(
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
-    mut creatures: Query<(
-        Entity,
-        &Creature,
-        &Lod,
-        &mut PlanarState,
-        &mut CollisionRecord,
-    )>,
+    mut creatures: Query<(Entity, &Creature, &Lod, &mut PlanarState, &mut CollisionRecord)>,
 ) {
     let grid = clock.is_decision_tick().then_some(&*grid);
     for_each_creature!(config.scenario.creature_count(), creatures, |(
@@ -194,8 +186,7 @@ fn detect_collisions(
             return;
         }
         let kind = &kinds[creature.kind];
-        let impact =
-            collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
+        let impact = collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
         if impact > kind.fall_impact_speed_m_per_s {
             falls
                 .0
@@ -207,7 +198,6 @@ fn detect_collisions(
 }
 
 /// Removes the fallen and starts a new creature of the same kind in a free spot.
-#[allow(clippy::too_many_arguments)]
 fn respawn_fallen(
     mut commands: Commands,
     config: Res<SimConfig>,
@@ -243,13 +233,7 @@ fn respawn_fallen(
                 .min(p.distance(puck.position) - puck_keep_out)
         });
         commands.entity(entity).despawn();
-        commands.spawn(creature_bundle(
-            creature.kind,
-            serials.next(),
-            *lod,
-            spot,
-            &mut rng,
-        ));
+        commands.spawn(creature_bundle(creature.kind, serials.take(), *lod, spot, &mut rng));
     }
 }
 
@@ -323,8 +307,6 @@ pub(super) fn plugin(app: &mut App) {
         .add_systems(FixedUpdate, detect_collisions.in_set(SimStage::Observe))
         .add_systems(
             FixedUpdate,
-            (respawn_fallen, advance_clock)
-                .chain()
-                .in_set(SimStage::Outcome),
+            (respawn_fallen, advance_clock).chain().in_set(SimStage::Outcome),
         );
 }

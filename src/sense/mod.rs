@@ -74,10 +74,8 @@ impl NeighbourGrid {
         // Scatter in input order within each cell: deterministic.
         let mut next = self.cell_start.clone();
         self.entries.clear();
-        self.entries.resize(
-            self.scratch.len(),
-            self.scratch.first().copied().unwrap_or(EMPTY),
-        );
+        self.entries
+            .resize(self.scratch.len(), self.scratch.first().copied().unwrap_or(EMPTY));
         for (n, &c) in self.scratch.iter().zip(&self.cell_of_entry) {
             let slot = &mut next[c as usize];
             self.entries[*slot as usize] = *n;
@@ -115,9 +113,7 @@ impl NeighbourGrid {
     /// Distance from `p` to the nearest entry's rim, looking no further than `radius`.
     pub fn clearance(&self, p: Vec2, radius: f32) -> f32 {
         let mut best = radius;
-        self.for_each_within(p, radius, |n| {
-            best = best.min(n.position.distance(p) - n.radius)
-        });
+        self.for_each_within(p, radius, |n| best = best.min(n.position.distance(p) - n.radius));
         best
     }
 }

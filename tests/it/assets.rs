@@ -13,10 +13,7 @@ fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
     let dir = scratch_dir(test);
     for sub in ["", "creatures", "scenarios"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
-        for entry in std::fs::read_dir(assets_root().join(sub))
-            .unwrap()
-            .flatten()
-        {
+        for entry in std::fs::read_dir(assets_root().join(sub)).unwrap().flatten() {
             if entry.path().is_file() {
                 std::fs::copy(entry.path(), dir.join(sub).join(entry.file_name())).unwrap();
             }
@@ -35,8 +32,7 @@ fn edited(file: &str, from: &str, to: &str) -> Vec<u8> {
 
 fn load_error(test: &str, file: &str, contents: &[u8]) -> ConfigError {
     let root = assets_with(test, file, contents);
-    SimConfig::load(&root.join("scenarios/default.ron"), &root)
-        .expect_err("a broken file must not load")
+    SimConfig::load(&root.join("scenarios/default.ron"), &root).expect_err("a broken file must not load")
 }
 
 fn assert_names(err: &ConfigError, file: &str, field: &str, words: &str) {
@@ -56,14 +52,7 @@ fn assert_names(err: &ConfigError, file: &str, field: &str, words: &str) {
 fn shipped_assets_load_and_validate() {
     let config = default_config();
     assert_eq!(config.kinds.len(), 2);
-    assert!(
-        config.arena.puck.speed_m_per_s
-            > config
-                .kinds
-                .iter()
-                .map(|k| k.top_speed_m_per_s)
-                .fold(0.0, f32::max)
-    );
+    assert!(config.arena.puck.speed_m_per_s > config.kinds.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max));
 }
 
 #[test]
@@ -83,12 +72,7 @@ fn a_negative_mass_is_refused() {
         "creatures/hopper.ron",
         &edited("creatures/hopper.ron", "mass_kg: 10.0", "mass_kg: -10.0"),
     );
-    assert_names(
-        &err,
-        "creatures/hopper.ron",
-        "body.mass_kg",
-        "greater than 0, got -10",
-    );
+    assert_names(&err, "creatures/hopper.ron", "body.mass_kg", "greater than 0, got -10");
 }
 
 #[test]
@@ -124,27 +108,14 @@ fn a_court_smaller_than_the_puck_is_refused() {
         "arena.ron",
         &edited("arena.ron", "court_width_m: 40.0", "court_width_m: 3.0"),
     );
-    assert_names(
-        &err,
-        "arena.ron",
-        "puck.radius_m",
-        "does not fit in the court",
-    );
+    assert_names(&err, "arena.ron", "puck.radius_m", "does not fit in the court");
 }
 
 #[test]
 fn garbage_bytes_are_refused() {
-    let err = load_error(
-        "garbage",
-        "creatures/biped.ron",
-        &[0xff, 0xfe, 0x00, 0x13, 0x37, 0x80],
-    );
+    let err = load_error("garbage", "creatures/biped.ron", &[0xff, 0xfe, 0x00, 0x13, 0x37, 0x80]);
     assert_names(&err, "creatures/biped.ron", "", "not a ron text file");
-    let err = load_error(
-        "garbage_text",
-        "creatures/biped.ron",
-        b"{{ this is not ron ]",
-    );
+    let err = load_error("garbage_text", "creatures/biped.ron", b"{{ this is not ron ]");
     assert_names(&err, "creatures/biped.ron", "", "line 1");
 }
 
@@ -171,10 +142,9 @@ fn every_problem_in_a_file_is_reported_at_once() {
         "top_speed_m_per_s: 3.0",
         "top_speed_m_per_s: -3.0",
     );
-    let bytes =
-        String::from_utf8(bytes)
-            .unwrap()
-            .replacen("hop_period_s: 0.5", "hop_period_s: 0.0", 1);
+    let bytes = String::from_utf8(bytes)
+        .unwrap()
+        .replacen("hop_period_s: 0.5", "hop_period_s: 0.0", 1);
     let err = load_error("two_problems", "creatures/hopper.ron", bytes.as_bytes());
     let fields: Vec<&str> = err.problems.iter().map(|p| p.field.as_str()).collect();
     assert!(
@@ -201,12 +171,7 @@ fn load_through_asset_server<A: Asset + Clone>(root: &Path, file: &str) -> Resul
         app.update();
         match app.world().resource::<AssetServer>().load_state(&handle) {
             LoadState::Loaded => {
-                return Ok(app
-                    .world()
-                    .resource::<Assets<A>>()
-                    .get(&handle)
-                    .unwrap()
-                    .clone());
+                return Ok(app.world().resource::<Assets<A>>().get(&handle).unwrap().clone());
             }
             LoadState::Failed(e) => return Err(e.to_string()),
             _ => std::thread::sleep(std::time::Duration::from_millis(1)),
@@ -224,10 +189,7 @@ fn the_asset_server_loads_the_same_values_as_the_file_path() {
         load_file::<Scenario>(&root.join("scenarios/default.ron")).unwrap()
     );
     let arena: ArenaConfig = load_through_asset_server(&root, "arena.ron").unwrap();
-    assert_eq!(
-        arena,
-        load_file::<ArenaConfig>(&root.join("arena.ron")).unwrap()
-    );
+    assert_eq!(arena, load_file::<ArenaConfig>(&root.join("arena.ron")).unwrap());
     let hopper: CreatureDef = load_through_asset_server(&root, "creatures/hopper.ron").unwrap();
     assert_eq!(
         hopper,

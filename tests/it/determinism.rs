@@ -3,10 +3,7 @@
 use crate::support::*;
 use simlod::headless::HeadlessSim;
 
-fn digest_after(
-    config: simlod::config::SimConfig,
-    seconds: f64,
-) -> (u64, simlod::outcome::Summary) {
+fn digest_after(config: simlod::config::SimConfig, seconds: f64) -> (u64, simlod::outcome::Summary) {
     let mut sim = HeadlessSim::new(config);
     sim.run_for(seconds);
     let mut summary = sim.summary(0.0);
@@ -36,8 +33,5 @@ fn a_crowd_large_enough_to_run_in_parallel_is_deterministic_too() {
 fn another_seed_gives_another_game() {
     let mut other = default_config();
     other.scenario.seed += 1;
-    assert_ne!(
-        digest_after(default_config(), 5.0).0,
-        digest_after(other, 5.0).0
-    );
+    assert_ne!(digest_after(default_config(), 5.0).0, digest_after(other, 5.0).0);
 }

@@ -17,12 +17,7 @@ fn respawning_keeps_the_creature_count_constant() {
     while sim.clock().seconds() < 30.0 {
         sim.advance_frame();
         let all = creatures(&mut sim);
-        assert_eq!(
-            all.len(),
-            n,
-            "creature count at {} s",
-            sim.clock().seconds()
-        );
+        assert_eq!(all.len(), n, "creature count at {} s", sim.clock().seconds());
         let puck = *sim.app.world().resource::<PuckState>();
         for (c, s) in &all {
             if c.serial > last_max_serial && c.serial >= n as u32 {
@@ -73,8 +68,5 @@ fn a_creature_in_the_pucks_path_is_hit_and_counted() {
             break;
         }
     }
-    assert!(
-        hit,
-        "the puck moving at {v} never hit the creature in its path"
-    );
+    assert!(hit, "the puck moving at {v} never hit the creature in its path");
 }

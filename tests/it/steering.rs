@@ -51,8 +51,7 @@ fn steering_keeps_collisions_with_the_puck_and_walls_low_in_the_default_scenario
     let config = default_config();
     let creatures = u64::from(config.scenario.creature_count());
     let (puck, wall, collided) = hits(&config, 20.0);
-    let (puck_unsteered, wall_unsteered, collided_unsteered) =
-        hits(&without_steering(config), 20.0);
+    let (puck_unsteered, wall_unsteered, collided_unsteered) = hits(&without_steering(config), 20.0);
     eprintln!(
         "steered: puck {puck} wall {wall} creatures {collided}; unsteered: puck {puck_unsteered} wall {wall_unsteered} creatures {collided_unsteered}"
     );
