@@ -57,6 +57,11 @@ pub struct GaitPhase {
     pub in_flight: bool,
 }
 
+/// A creature whose desired velocity comes from outside (the player's keyboard, a test, an
+/// experiment): steering leaves it alone.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct PlayerControlled;
+
 /// The planar velocity steering asks for.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct DesiredVelocity(pub Vec2);

@@ -8,7 +8,7 @@
 
 use bevy::prelude::*;
 
-use super::{Creature, DesiredVelocity, KindParams, KindTable, PlanarState};
+use super::{Creature, DesiredVelocity, KindParams, KindTable, PlanarState, PlayerControlled};
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
 use crate::sense::NeighbourGrid;
@@ -113,7 +113,7 @@ fn steer(
     puck: Res<PuckState>,
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
-    mut creatures: Query<(&Creature, &PlanarState, &mut DesiredVelocity)>,
+    mut creatures: Query<(&Creature, &PlanarState, &mut DesiredVelocity), Without<PlayerControlled>>,
 ) {
     if !clock.is_decision_tick() {
         return;
