@@ -22,6 +22,10 @@ pub struct Court {
 #[derive(Component, Debug)]
 pub struct Puck;
 
+/// The ground under the court (a fixed rapier collider).
+#[derive(Component, Debug)]
+pub struct Ground;
+
 /// A wall of the court (a fixed rapier collider).
 #[derive(Component, Debug)]
 pub struct Wall;
@@ -48,6 +52,8 @@ pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rn
     // Ground: a slab whose top is y = 0.
     commands.spawn((
         Name::new("ground"),
+        Ground,
+        Friction::coefficient(1.0),
         RigidBody::Fixed,
         Collider::cuboid(half.x + t, 0.5, half.y + t),
         Transform::from_xyz(0.0, -0.5, 0.0),

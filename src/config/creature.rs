@@ -25,6 +25,74 @@ pub struct CreatureDef {
     /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop).
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
+    /// The rigid-body model (paper 3.1); a kind without one is never simulated rigid.
+    #[serde(default)]
+    pub rigid: Option<RigidConfig>,
+}
+
+/// The rigid-body hopper of the paper's figure 2: a body, an upper leg on a three-axis hip
+/// at the body's centre, and a lower leg with a ball foot on a springy prismatic joint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidConfig {
+    /// Half extents of the body box: x forward, y up, z to the side. Its mass is `body.mass_kg`.
+    pub body_half_extents_m: (f32, f32, f32),
+    pub upper_leg_length_m: f32,
+    pub upper_leg_mass_kg: f32,
+    pub lower_leg_length_m: f32,
+    pub lower_leg_mass_kg: f32,
+    pub leg_radius_m: f32,
+    pub foot_radius_m: f32,
+    pub foot_friction: f32,
+    /// Hip to foot centre with the spring at rest.
+    pub leg_rest_length_m: f32,
+    /// Hip to foot centre at the joint's stop.
+    pub leg_min_length_m: f32,
+    pub leg_spring_n_per_m: f32,
+    pub leg_damping_n_s_per_m: f32,
+    pub controller: RaibertConfig,
+    pub fall: FallConfig,
+}
+
+/// Raibert's three decoupled controllers (Legged Robots That Balance, 1986).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RaibertConfig {
+    /// Hop height: the flight time the thrust is adjusted to.
+    pub flight_time_s: f32,
+    /// Extra spring extension during thrust, at the start.
+    pub thrust_initial_m: f32,
+    pub thrust_max_m: f32,
+    /// Thrust change per second of flight-time error, once a hop.
+    pub thrust_gain_m_per_s: f32,
+    /// Foot placement: neutral point plus this times the velocity error.
+    pub speed_gain_s: f32,
+    /// Share of each hop's velocity error added to a running correction of the commanded
+    /// velocity (integral action: removes the steady error a biased neutral point leaves).
+    pub speed_integral_gain: f32,
+    /// Largest foot offset from under the hip, as a fraction of the leg length.
+    pub max_foot_offset_fraction: f32,
+    /// Flight: hip torque swinging the leg to the foot placement angle.
+    pub swing_kp_nm_per_rad: f32,
+    pub swing_kd_nm_s_per_rad: f32,
+    /// Stance: hip torque holding the body level (pitch and roll).
+    pub attitude_kp_nm_per_rad: f32,
+    pub attitude_kd_nm_s_per_rad: f32,
+    /// Stance: torque turning the body to its heading, through the foot's grip.
+    pub yaw_kp_nm_per_rad: f32,
+    pub yaw_kd_nm_s_per_rad: f32,
+    /// Largest yaw torque the foot's grip on the ground can take.
+    pub yaw_max_torque_nm: f32,
+}
+
+/// When a rigid creature has fallen.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FallConfig {
+    /// The body's centre below this height.
+    pub body_min_height_m: f32,
+    /// The body's up axis tilted further than this from vertical.
+    pub max_tilt_deg: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -84,6 +152,9 @@ impl Validate for CreatureDef {
         v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
         v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);
         v.within("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        if let Some(r) = &self.rigid {
+            v.nested("rigid", |v| r.validate(v));
+        }
         let s = &self.steering;
         v.nested("steering", |v| {
             v.non_negative("cruise_speed_m_per_s", s.cruise_speed_m_per_s);
@@ -100,6 +171,66 @@ impl Validate for CreatureDef {
                 "cruise_speed_m_per_s",
                 format!("must not exceed top_speed_m_per_s ({})", self.top_speed_m_per_s),
             );
+        });
+    }
+}
+
+impl Validate for RigidConfig {
+    fn validate(&self, v: &mut Validator) {
+        let (x, y, z) = self.body_half_extents_m;
+        for (i, e) in [x, y, z].into_iter().enumerate() {
+            v.positive(&format!("body_half_extents_m.{i}"), e);
+        }
+        v.positive("upper_leg_length_m", self.upper_leg_length_m);
+        v.positive("upper_leg_mass_kg", self.upper_leg_mass_kg);
+        v.positive("lower_leg_length_m", self.lower_leg_length_m);
+        v.positive("lower_leg_mass_kg", self.lower_leg_mass_kg);
+        v.positive("leg_radius_m", self.leg_radius_m);
+        v.positive("foot_radius_m", self.foot_radius_m);
+        v.non_negative("foot_friction", self.foot_friction);
+        v.positive("leg_rest_length_m", self.leg_rest_length_m);
+        v.positive("leg_min_length_m", self.leg_min_length_m);
+        v.positive("leg_spring_n_per_m", self.leg_spring_n_per_m);
+        v.non_negative("leg_damping_n_s_per_m", self.leg_damping_n_s_per_m);
+        v.require(
+            self.leg_min_length_m < self.leg_rest_length_m,
+            "leg_min_length_m",
+            format!("must be below leg_rest_length_m ({})", self.leg_rest_length_m),
+        );
+        v.require(
+            self.lower_leg_length_m + y < self.leg_min_length_m,
+            "lower_leg_length_m",
+            "the lower leg would reach into the body at the shortest leg: keep lower_leg_length_m + body half height below leg_min_length_m",
+        );
+        let c = &self.controller;
+        v.nested("controller", |v| {
+            v.positive("flight_time_s", c.flight_time_s);
+            v.non_negative("thrust_initial_m", c.thrust_initial_m);
+            v.non_negative("thrust_max_m", c.thrust_max_m);
+            v.non_negative("thrust_gain_m_per_s", c.thrust_gain_m_per_s);
+            v.non_negative("speed_gain_s", c.speed_gain_s);
+            v.within("speed_integral_gain", c.speed_integral_gain, 0.0, 1.0);
+            v.within("max_foot_offset_fraction", c.max_foot_offset_fraction, 0.0, 0.9);
+            for (name, value) in [
+                ("swing_kp_nm_per_rad", c.swing_kp_nm_per_rad),
+                ("swing_kd_nm_s_per_rad", c.swing_kd_nm_s_per_rad),
+                ("attitude_kp_nm_per_rad", c.attitude_kp_nm_per_rad),
+                ("attitude_kd_nm_s_per_rad", c.attitude_kd_nm_s_per_rad),
+                ("yaw_kp_nm_per_rad", c.yaw_kp_nm_per_rad),
+                ("yaw_kd_nm_s_per_rad", c.yaw_kd_nm_s_per_rad),
+                ("yaw_max_torque_nm", c.yaw_max_torque_nm),
+            ] {
+                v.non_negative(name, value);
+            }
+            v.require(
+                c.thrust_initial_m <= c.thrust_max_m,
+                "thrust_initial_m",
+                "must not exceed thrust_max_m",
+            );
+        });
+        v.nested("fall", |v| {
+            v.positive("body_min_height_m", self.fall.body_min_height_m);
+            v.within("max_tilt_deg", self.fall.max_tilt_deg, 1.0, 180.0);
         });
     }
 }

@@ -11,7 +11,7 @@ mod scenario;
 mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
-pub use creature::{BodyConfig, CreatureDef, SteeringConfig};
+pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConfig, SteeringConfig};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};

@@ -7,7 +7,7 @@ use rand::RngExt;
 use std::ops::Index;
 
 use crate::WorldRng;
-use crate::config::{CreatureDef, SimConfig, SteeringConfig};
+use crate::config::{CreatureDef, RigidConfig, SimConfig, SteeringConfig};
 use crate::lod::Lod;
 use crate::outcome::CollisionRecord;
 use std::collections::HashMap;
@@ -80,6 +80,7 @@ pub struct KindParams {
     pub fall_impact_speed_m_per_s: f32,
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
+    pub rigid: Option<RigidConfig>,
 }
 
 impl From<&CreatureDef> for KindParams {
@@ -94,6 +95,7 @@ impl From<&CreatureDef> for KindParams {
             fall_impact_speed_m_per_s: d.fall_impact_speed_m_per_s,
             collision_restitution: d.collision_restitution,
             steering: d.steering.clone(),
+            rigid: d.rigid.clone(),
         }
     }
 }
@@ -220,13 +222,16 @@ fn spawn_creatures(
         cells: HashMap::new(),
     };
     let puck_keep_out = config.arena.puck.radius_m + config.arena.respawn_puck_clearance_m;
-    let level = config.scenario.level_policy.initial_level();
     let mut batch = Vec::with_capacity(config.scenario.creature_count() as usize);
     for group in &config.scenario.creatures {
         let kind = config
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
+        let level = config
+            .scenario
+            .level_policy
+            .initial_level(config.kinds[kind].rigid.is_some());
         for _ in 0..group.count {
             // The puck starts at the centre.
             let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {

@@ -14,15 +14,18 @@ pub enum Lod {
     /// angle (section 3.3).
     #[default]
     PointMass,
+    /// Rapier rigid bodies and joints driven by Raibert's controller (section 3.1).
+    Rigid,
 }
 
 impl Lod {
-    pub const ALL: [Lod; 1] = [Lod::PointMass];
+    pub const ALL: [Lod; 2] = [Lod::PointMass, Lod::Rigid];
 
     /// The name used in summaries and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Lod::PointMass => "point_mass",
+            Lod::Rigid => "rigid",
         }
     }
 }
@@ -33,13 +36,17 @@ pub enum LevelPolicy {
     /// Every creature at the point-mass level.
     #[default]
     AllPointMass,
+    /// Every creature whose kind has a rigid model at the rigid level; the others at the
+    /// point-mass level.
+    AllRigid,
 }
 
 impl LevelPolicy {
-    /// The level a newly spawned creature starts at.
-    pub fn initial_level(self) -> Lod {
+    /// The level a newly spawned creature of a kind starts at.
+    pub fn initial_level(self, has_rigid_model: bool) -> Lod {
         match self {
-            LevelPolicy::AllPointMass => Lod::PointMass,
+            LevelPolicy::AllRigid if has_rigid_model => Lod::Rigid,
+            LevelPolicy::AllPointMass | LevelPolicy::AllRigid => Lod::PointMass,
         }
     }
 }

@@ -88,6 +88,7 @@ mod tests {
                 separation_distance_m: 0.0,
                 separation_weight: 0.0,
             },
+            rigid: None,
         }
     }
 

@@ -58,7 +58,7 @@ impl CollisionRecord {
     }
 
     /// Notes whether the creature touches `obstacle` now; a new contact is a collision.
-    fn note(&mut self, obstacle: Obstacle, touching: bool) {
+    pub(crate) fn note(&mut self, obstacle: Obstacle, touching: bool) {
         let i = obstacle as usize;
         if touching && !self.touching[i] {
             self.count[i] += 1;
@@ -70,6 +70,13 @@ impl CollisionRecord {
 /// Creatures that fell this tick; filled in parallel, emptied in serial order.
 #[derive(Resource, Default)]
 pub struct FallQueue(Mutex<Vec<(u32, Entity)>>);
+
+impl FallQueue {
+    /// Marks a creature (by serial and entity) as fallen this tick.
+    pub fn push(&self, serial: u32, entity: Entity) {
+        self.0.lock().unwrap_or_else(|p| p.into_inner()).push((serial, entity));
+    }
+}
 
 /// Counts kept for the whole run, beyond those of the creatures alive now.
 #[derive(Resource, Clone, Debug, Default)]
@@ -188,11 +195,7 @@ fn detect_collisions(
         let kind = &kinds[creature.kind];
         let impact = collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
         if impact > kind.fall_impact_speed_m_per_s {
-            falls
-                .0
-                .lock()
-                .unwrap_or_else(|p| p.into_inner())
-                .push((creature.serial, entity));
+            falls.push(creature.serial, entity);
         }
     });
 }
@@ -213,7 +216,9 @@ fn respawn_fallen(
     if fallen.is_empty() {
         return;
     }
+    // A creature can be reported twice in a tick (a blow-up and a tilt): one removal.
     fallen.sort_unstable();
+    fallen.dedup();
     let half = config.arena.half_extents();
     let clear = config.arena.respawn_creature_clearance_m;
     let puck_keep_out = puck.radius_m + config.arena.respawn_puck_clearance_m;

@@ -5,5 +5,6 @@ mod assets;
 mod court;
 mod determinism;
 mod outcome;
+mod rigid;
 mod steering;
 mod support;
