@@ -35,6 +35,7 @@ pub mod arena;
 pub mod bench;
 pub mod config;
 pub mod creature;
+pub mod experiments;
 pub mod headless;
 pub mod lod;
 pub mod models;

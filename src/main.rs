@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use simlod::config::SimConfig;
 use simlod::lod::LevelPolicy;
 use simlod::outcome::Summary;
-use simlod::{bench, headless};
+use simlod::{bench, experiments, headless};
 
 #[derive(Parser)]
 #[command(
@@ -26,6 +26,29 @@ enum Command {
     Run(RunArgs),
     /// Measure the cost per creature per 1/30 s of motion and the most creatures at 30 fps.
     Bench(BenchArgs),
+    /// Run one of the paper's experiments and write its data as CSV.
+    Experiment(ExperimentArgs),
+}
+
+#[derive(Args)]
+struct ExperimentArgs {
+    #[command(subcommand)]
+    which: ExperimentKind,
+}
+
+#[derive(Subcommand)]
+enum ExperimentKind {
+    /// Figures 3 and 4: velocity and ground path under step changes in desired velocity.
+    StepResponse {
+        #[command(flatten)]
+        scenario: ScenarioArgs,
+        /// The experiment's file.
+        #[arg(long, default_value = "assets/experiments/step_response.ron")]
+        experiment: PathBuf,
+        /// Folder the CSV files are written to.
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 #[derive(Args)]
@@ -129,6 +152,17 @@ fn main() -> ExitCode {
             .scenario
             .load()
             .map(|config| bench::run(&config, args.quick, args.json)),
+        Command::Experiment(ExperimentArgs {
+            which:
+                ExperimentKind::StepResponse {
+                    scenario,
+                    experiment,
+                    out,
+                },
+        }) => scenario
+            .load()
+            .and_then(|config| experiments::step_response::run(&config, &experiment, &out))
+            .map(|summary| print!("{summary}")),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

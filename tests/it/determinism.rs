@@ -35,3 +35,12 @@ fn another_seed_gives_another_game() {
     other.scenario.seed += 1;
     assert_ne!(digest_after(default_config(), 5.0).0, digest_after(other, 5.0).0);
 }
+
+#[test]
+fn the_rigid_level_is_deterministic_too() {
+    let mut config = default_config();
+    config.scenario.level_policy = simlod::lod::LevelPolicy::AllRigid;
+    let a = digest_after(config.clone(), 5.0);
+    assert_eq!(a, digest_after(config, 5.0));
+    assert_eq!(a.1.levels["rigid"], 30);
+}

@@ -4,6 +4,7 @@
 mod assets;
 mod court;
 mod determinism;
+mod experiments;
 mod outcome;
 mod rigid;
 mod steering;

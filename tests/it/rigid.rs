@@ -5,28 +5,25 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::support::*;
-use simlod::creature::{Creature, DesiredVelocity, PlanarState, PlayerControlled};
+use simlod::creature::{DesiredVelocity, PlanarState};
+use simlod::experiments::lone_creature;
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::{Raibert, RigidHopper, RigidPart, Shove};
 
-/// One rigid hopper in a court big enough to run in for a minute, the puck parked far away,
-/// steered from outside at `desired`.
+/// One rigid hopper steered from outside at `desired`, far from the walls and the parked puck.
 pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
-    let mut config = config_with_hoppers(1);
-    config.scenario.level_policy = LevelPolicy::AllRigid;
-    config.arena.court_length_m = 420.0;
-    config.arena.court_width_m = 420.0;
-    config.arena.puck.speed_m_per_s = 0.001;
-    let mut sim = HeadlessSim::new(config);
-    let world = sim.app.world_mut();
-    let entity = world.query_filtered::<Entity, With<Creature>>().single(world).unwrap();
-    let mut e = world.entity_mut(entity);
-    e.insert((PlayerControlled, DesiredVelocity(desired)));
-    let mut state = e.get_mut::<PlanarState>().unwrap();
-    state.position = Vec2::new(-180.0, 100.0);
-    state.heading = desired.try_normalize().unwrap_or(Vec2::X);
-    (sim, entity)
+    let (mut sim, hopper) = lone_creature(
+        &default_config(),
+        "hopper",
+        LevelPolicy::AllRigid,
+        Vec2::new(-180.0, 100.0),
+        420.0,
+    );
+    let mut e = sim.app.world_mut().entity_mut(hopper);
+    e.insert(DesiredVelocity(desired));
+    e.get_mut::<PlanarState>().unwrap().heading = desired.try_normalize().unwrap_or(Vec2::X);
+    (sim, hopper)
 }
 
 fn state(sim: &mut HeadlessSim, entity: Entity) -> Option<PlanarState> {

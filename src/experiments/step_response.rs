@@ -1,0 +1,153 @@
+//! Figures 3 and 4: velocity and ground path of a creature under step changes in desired
+//! velocity, for each model; and how far apart the models end up after the run (section
+//! 3.2: "even small differences in velocity can result in substantial changes in final
+//! position").
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::lone_creature;
+use crate::config::{ConfigError, SimConfig, Validate, Validator, load_file};
+use crate::creature::{DesiredVelocity, PlanarState};
+use crate::lod::LevelPolicy;
+
+/// `assets/experiments/step_response.ron`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StepResponseConfig {
+    pub creature: String,
+    pub duration_s: f32,
+    pub start_m: (f32, f32),
+    pub steps: Vec<VelocityStep>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VelocityStep {
+    pub at_s: f32,
+    /// Desired planar velocity (x, z) from `at_s` on.
+    pub velocity_m_per_s: (f32, f32),
+}
+
+impl Validate for StepResponseConfig {
+    fn validate(&self, v: &mut Validator) {
+        v.positive("duration_s", self.duration_s);
+        v.require(!self.steps.is_empty(), "steps", "must hold at least one step");
+        for (i, s) in self.steps.iter().enumerate() {
+            v.non_negative(&format!("steps[{i}].at_s"), s.at_s);
+            v.within(
+                &format!("steps[{i}].velocity_m_per_s.0"),
+                s.velocity_m_per_s.0,
+                -10.0,
+                10.0,
+            );
+            v.within(
+                &format!("steps[{i}].velocity_m_per_s.1"),
+                s.velocity_m_per_s.1,
+                -10.0,
+                10.0,
+            );
+        }
+        v.require(
+            self.steps.windows(2).all(|w| w[0].at_s < w[1].at_s),
+            "steps",
+            "must be in increasing order of at_s",
+        );
+    }
+}
+
+impl StepResponseConfig {
+    /// The desired velocity at time `t`.
+    pub fn desired_at(&self, t: f32) -> Vec2 {
+        let step = self.steps.iter().rev().find(|s| s.at_s <= t).unwrap_or(&self.steps[0]);
+        Vec2::new(step.velocity_m_per_s.0, step.velocity_m_per_s.1)
+    }
+}
+
+/// One model's run, sampled once a frame (30 Hz).
+#[derive(Clone, Debug)]
+pub struct Trace {
+    pub model: &'static str,
+    /// (time, desired velocity, state)
+    pub samples: Vec<(f32, Vec2, PlanarState)>,
+}
+
+/// Runs the schedule on one model.
+pub fn trace(
+    sim_config: &SimConfig,
+    experiment: &StepResponseConfig,
+    model: &'static str,
+    policy: LevelPolicy,
+) -> Trace {
+    let start = Vec2::new(experiment.start_m.0, experiment.start_m.1);
+    let (mut sim, creature) = lone_creature(sim_config, &experiment.creature, policy, start, 300.0);
+    let mut samples = Vec::new();
+    while sim.clock().seconds() < f64::from(experiment.duration_s) {
+        let t = sim.clock().seconds() as f32;
+        let desired = experiment.desired_at(t);
+        let world = sim.app.world_mut();
+        let Some(mut d) = world.get_mut::<DesiredVelocity>(creature) else {
+            break;
+        };
+        d.0 = desired;
+        sim.advance_frame();
+        let Some(state) = sim.app.world().get::<PlanarState>(creature) else {
+            break;
+        };
+        samples.push((sim.clock().seconds() as f32, desired, *state));
+    }
+    Trace { model, samples }
+}
+
+/// Writes `velocity.csv` (figure 3) and `path.csv` (figure 4) into `out`; returns a summary.
+pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result<String, String> {
+    let experiment: StepResponseConfig = load_file(experiment_file).map_err(|e: ConfigError| e.to_string())?;
+    if sim_config.kind_index(&experiment.creature).is_none() {
+        return Err(format!(
+            "{}: field `creature`: the scenario has no creature kind {:?}",
+            experiment_file.display(),
+            experiment.creature
+        ));
+    }
+    let traces = [trace(sim_config, &experiment, "rigid", LevelPolicy::AllRigid)];
+    let mut velocity = String::from(
+        "model,t_s,desired_vx_m_per_s,desired_vz_m_per_s,vx_m_per_s,vz_m_per_s,desired_speed_m_per_s,speed_m_per_s\n",
+    );
+    let mut path = String::from("model,t_s,x_m,z_m\n");
+    let mut summary = String::new();
+    for tr in &traces {
+        for (t, d, s) in &tr.samples {
+            let _ = writeln!(
+                velocity,
+                "{},{t:.4},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+                tr.model,
+                d.x,
+                d.y,
+                s.velocity.x,
+                s.velocity.y,
+                d.length(),
+                s.velocity.length()
+            );
+            let _ = writeln!(path, "{},{t:.4},{:.4},{:.4}", tr.model, s.position.x, s.position.y);
+        }
+        let end = tr.samples.last().map_or(Vec2::ZERO, |s| s.2.position);
+        let _ = writeln!(
+            summary,
+            "{}: {} samples over {:.2} s, final position ({:.3}, {:.3}) m",
+            tr.model,
+            tr.samples.len(),
+            tr.samples.last().map_or(0.0, |s| s.0),
+            end.x,
+            end.y
+        );
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    for (name, text) in [("velocity.csv", &velocity), ("path.csv", &path)] {
+        let file = out.join(name);
+        std::fs::write(&file, text).map_err(|e| format!("cannot write {}: {e}", file.display()))?;
+        let _ = writeln!(summary, "wrote {}", file.display());
+    }
+    Ok(summary)
+}

@@ -1,0 +1,40 @@
+//! The paper's experiments write their data.
+
+use crate::support::*;
+use simlod::experiments::step_response;
+
+#[test]
+fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
+    let out = scratch_dir("step_response");
+    let file = assets_root().join("experiments/step_response.ron");
+    let summary = step_response::run(&default_config(), &file, &out).unwrap();
+    assert!(summary.contains("rigid: 240 samples"), "{summary}");
+    let velocity = std::fs::read_to_string(out.join("velocity.csv")).unwrap();
+    let path = std::fs::read_to_string(out.join("path.csv")).unwrap();
+    assert_eq!(velocity.lines().count(), 241);
+    assert_eq!(path.lines().count(), 241);
+    // The 2 m/s step at 1 s: by 3.5 s the hopper has sped up past 1.5 m/s along x.
+    let vx_at = |t: f32| -> f32 {
+        let row = velocity
+            .lines()
+            .skip(1)
+            .find(|l| l.split(',').nth(1).unwrap().parse::<f32>().unwrap() >= t)
+            .unwrap();
+        row.split(',').nth(4).unwrap().parse().unwrap()
+    };
+    assert!(vx_at(0.9).abs() < 0.05, "still at rest before the first step");
+    assert!(vx_at(3.45) > 1.5, "sped up after the step: {}", vx_at(3.45));
+}
+
+#[test]
+fn step_response_refuses_a_broken_experiment_file() {
+    let dir = scratch_dir("step_response_bad");
+    let file = dir.join("bad.ron");
+    std::fs::write(
+        &file,
+        "(creature: \"hopper\", duration_s: -1.0, start_m: (0.0, 0.0), steps: [])",
+    )
+    .unwrap();
+    let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
+    assert!(err.contains("`duration_s`") && err.contains("`steps`"), "{err}");
+}
