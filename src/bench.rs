@@ -69,8 +69,12 @@ pub fn median_frame_seconds(config: SimConfig, warmup: usize, frames: usize) -> 
     times[times.len() / 2]
 }
 
+/// How hard one level is measured.
 struct Effort {
+    /// The creature count the cost per creature is measured at.
     reference: u32,
+    /// The first count tried when searching for the most at 30 fps.
+    search_from: u32,
     warmup: usize,
     frames: usize,
     search_steps: u32,
@@ -81,7 +85,7 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
     let fits =
         |n: u32| median_frame_seconds(scaled(config, n, policy), effort.warmup / 2, effort.frames) <= FRAME_BUDGET_S;
     // Double until a count misses the budget, then halve the gap.
-    let (mut good, mut bad) = (0u32, 1000u32);
+    let (mut good, mut bad) = (0u32, effort.search_from);
     while bad < crate::config::MAX_CREATURES && fits(bad) {
         good = bad;
         bad = (bad * 2).min(crate::config::MAX_CREATURES);
@@ -103,32 +107,45 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
     }
 }
 
+/// The scenario with only the kinds that have a model at `level`.
+fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
+    let mut c = config.clone();
+    c.scenario.creatures.retain(|g| {
+        let kind = &config.kinds[config
+            .kind_index(&g.kind)
+            .expect("kinds are resolved when the config loads")];
+        level != Lod::Rigid || kind.rigid.is_some()
+    });
+    c
+}
+
 /// Runs the benchmark for every level and prints it.
 pub fn run(config: &SimConfig, quick: bool, json: bool) {
-    let effort = if quick {
-        Effort {
-            reference: 2_000,
-            warmup: 10,
-            frames: 15,
-            search_steps: 3,
-        }
-    } else {
-        Effort {
-            reference: 10_000,
-            warmup: 30,
-            frames: 45,
-            search_steps: 6,
-        }
-    };
-    let levels = [(Lod::PointMass, LevelPolicy::AllPointMass)];
+    let scale = |full: u32| if quick { (full / 5).max(1) } else { full };
+    let (warmup, frames, search_steps) = if quick { (10, 15, 3) } else { (30, 45, 6) };
+    let levels = [
+        (Lod::PointMass, LevelPolicy::AllPointMass, scale(10_000), 1000),
+        (Lod::Rigid, LevelPolicy::AllRigid, scale(100), 16),
+    ];
     if !json {
         println!(
-            "simlod bench: median of {} frames of 1/30 s; cost per creature at {} creatures; court scaled to the scenario's density",
-            effort.frames, effort.reference
+            "simlod bench: median of {frames} frames of 1/30 s (medians, one process); court scaled to the scenario's density"
         );
     }
-    for (level, policy) in levels {
-        let b = bench_level(config, level, policy, &effort);
+    let mut results = Vec::new();
+    for (level, policy, reference, search_from) in levels {
+        let effort = Effort {
+            reference,
+            search_from,
+            warmup,
+            frames,
+            search_steps,
+        };
+        let level_config = kinds_with(config, level);
+        if level_config.scenario.creatures.is_empty() {
+            continue;
+        }
+        let b = bench_level(&level_config, level, policy, &effort);
         if json {
             println!("{}", serde_json::to_string(&b).expect("a bench result serialises"));
         } else {
@@ -136,6 +153,21 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
                 "{:<11} {:>9.3} us per creature per frame ({:.2} ms a frame at {}); most creatures at 30 fps: {}",
                 b.level, b.us_per_creature_per_frame, b.frame_ms_median, b.reference_creatures, b.max_creatures_30fps
             );
+        }
+        results.push(b);
+    }
+    if let (Some(cheap), Some(rigid)) = (
+        results.iter().find(|b| b.level == "point_mass"),
+        results.iter().find(|b| b.level == "rigid"),
+    ) {
+        let ratio = rigid.us_per_creature_per_frame / cheap.us_per_creature_per_frame;
+        if json {
+            println!(
+                "{}",
+                serde_json::json!({ "ratio": "rigid/point_mass", "cost_per_creature": ratio })
+            );
+        } else {
+            println!("a rigid creature costs {ratio:.0} times a point mass");
         }
     }
 }
