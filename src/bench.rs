@@ -111,10 +111,14 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
 fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
     let mut c = config.clone();
     c.scenario.creatures.retain(|g| {
-        let kind = &config.kinds[config
+        let kind = config
             .kind_index(&g.kind)
-            .expect("kinds are resolved when the config loads")];
-        level != Lod::Rigid || kind.rigid.is_some()
+            .expect("kinds are resolved when the config loads");
+        match level {
+            Lod::PointMass => true,
+            Lod::Hybrid => config.gaits[kind].is_some(),
+            Lod::Rigid => config.kinds[kind].rigid.is_some(),
+        }
     });
     c
 }
@@ -125,6 +129,7 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
     let (warmup, frames, search_steps) = if quick { (10, 15, 3) } else { (30, 45, 6) };
     let levels = [
         (Lod::PointMass, LevelPolicy::AllPointMass, scale(10_000), 1000),
+        (Lod::Hybrid, LevelPolicy::AllHybrid, scale(10_000), 1000),
         (Lod::Rigid, LevelPolicy::AllRigid, scale(100), 16),
     ];
     if !json {
@@ -156,18 +161,23 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
         }
         results.push(b);
     }
-    if let (Some(cheap), Some(rigid)) = (
-        results.iter().find(|b| b.level == "point_mass"),
-        results.iter().find(|b| b.level == "rigid"),
-    ) {
-        let ratio = rigid.us_per_creature_per_frame / cheap.us_per_creature_per_frame;
-        if json {
-            println!(
-                "{}",
-                serde_json::json!({ "ratio": "rigid/point_mass", "cost_per_creature": ratio })
-            );
-        } else {
-            println!("a rigid creature costs {ratio:.0} times a point mass");
+    let cost = |level: &str| {
+        results
+            .iter()
+            .find(|b| b.level == level)
+            .map(|b| b.us_per_creature_per_frame)
+    };
+    for cheaper in ["hybrid", "point_mass"] {
+        if let (Some(rigid), Some(cheap)) = (cost("rigid"), cost(cheaper)) {
+            let ratio = rigid / cheap;
+            if json {
+                println!(
+                    "{}",
+                    serde_json::json!({ "ratio": format!("rigid/{cheaper}"), "cost_per_creature": ratio })
+                );
+            } else {
+                println!("a rigid creature costs {ratio:.0} times a {cheaper} one");
+            }
         }
     }
 }

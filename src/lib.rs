@@ -36,6 +36,7 @@ pub mod bench;
 pub mod config;
 pub mod creature;
 pub mod experiments;
+pub mod gait;
 pub mod headless;
 pub mod lod;
 pub mod models;
@@ -133,6 +134,7 @@ impl Plugin for SimPlugin {
             s.set_executor(SingleThreadedExecutor::new());
         });
         config::plugin(app);
+        gait::plugin(app);
         arena::plugin(app);
         creature::plugin(app);
         sense::plugin(app);

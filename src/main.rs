@@ -4,7 +4,8 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use simlod::config::SimConfig;
+use simlod::config::{CreatureDef, CreatureGroup, SimConfig, load_file};
+use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::LevelPolicy;
 use simlod::outcome::Summary;
 use simlod::{bench, experiments, headless};
@@ -28,6 +29,96 @@ enum Command {
     Bench(BenchArgs),
     /// Run one of the paper's experiments and write its data as CSV.
     Experiment(ExperimentArgs),
+    /// Record a creature's gait table from its rigid model (paper 3.2).
+    RecordGait(RecordGaitArgs),
+}
+
+#[derive(Args)]
+struct RecordGaitArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// The creature file; it must have a `rigid` section.
+    #[arg(long)]
+    creature: PathBuf,
+    /// Steady forward speeds to record, increasing.
+    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3")]
+    speeds: Vec<f32>,
+    /// Where to write the table (default: the creature's `gait_table`, or gaits/<kind>.ron
+    /// under the assets folder).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+impl RecordGaitArgs {
+    fn run(&self) -> Result<(), String> {
+        let mut config = self.scenario.load()?;
+        let def: CreatureDef = load_file(&self.creature).map_err(|e| e.to_string())?;
+        if def.rigid.is_none() {
+            return Err(format!(
+                "{}: the creature has no `rigid` section to record from",
+                self.creature.display()
+            ));
+        }
+        if self.speeds.is_empty()
+            || self.speeds.windows(2).any(|w| w[0] >= w[1])
+            || self.speeds.iter().any(|v| !(0.0..=10.0).contains(v))
+        {
+            return Err(format!(
+                "--speeds must be increasing speeds between 0 and 10 m/s, got {:?}",
+                self.speeds
+            ));
+        }
+        // The recording never depends on a table recorded before.
+        let index = config.kind_index(&def.name).unwrap_or_else(|| {
+            config.kinds.push(def.clone());
+            config.gaits.push(None);
+            config.kinds.len() - 1
+        });
+        config.kinds[index] = def.clone();
+        config.gaits[index] = None;
+        config.scenario.creatures = vec![CreatureGroup {
+            kind: def.name.clone(),
+            count: 1,
+        }];
+        let settings = RecordSettings {
+            speeds_m_per_s: self.speeds.clone(),
+            ..RecordSettings::default()
+        };
+        let table = record(&config, &def.name, &settings)?;
+        let out = self.out.clone().unwrap_or_else(|| {
+            self.scenario.assets.join(
+                def.gait_table
+                    .clone()
+                    .unwrap_or_else(|| format!("gaits/{}.ron", def.name)),
+            )
+        });
+        let speeds: Vec<String> = self.speeds.iter().map(f32::to_string).collect();
+        let command = format!(
+            "simlod record-gait --creature {} --speeds {}",
+            self.creature.display(),
+            speeds.join(",")
+        );
+        if let Some(dir) = out.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        }
+        std::fs::write(&out, to_file_text(&table, &command))
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        println!("recorded {} from its rigid model into {}", def.name, out.display());
+        for row in &table.rows {
+            println!(
+                "  {:.3} m/s: hop {:.3} s, stance {:.0} %, {} samples",
+                row.speed_m_per_s,
+                row.hop_period_s,
+                row.stance_fraction * 100.0,
+                row.samples.len()
+            );
+        }
+        println!(
+            "  effective limits for the point mass: top speed {:.3} m/s, acceleration {:.3} m/s^2",
+            table.top_speed_m_per_s, table.acceleration_limit_m_per_s2
+        );
+        Ok(())
+    }
 }
 
 #[derive(Args)]
@@ -148,6 +239,7 @@ fn main() -> ExitCode {
                 print_summary(&args, &summary, &config);
             }
         }),
+        Command::RecordGait(args) => args.run(),
         Command::Bench(args) => args
             .scenario
             .load()

@@ -11,9 +11,11 @@ pub struct CreatureDef {
     /// The kind's name; must match the file name (`creatures/<name>.ron`).
     pub name: String,
     pub body: BodyConfig,
-    /// Planar speed limit of the point mass (paper 3.2).
+    /// Planar speed limit. A kind with a gait table moves its point mass (hybrid and point-mass
+    /// levels) at the table's measured limits instead (paper 3.2).
     pub top_speed_m_per_s: f32,
-    /// Planar acceleration limit of the point mass (paper 3.2).
+    /// How fast the creature may change its velocity: the rigid model's command follows the
+    /// desired velocity at this rate; the point mass uses it when there is no gait table.
     pub acceleration_limit_m_per_s2: f32,
     /// Touchdown to touchdown.
     pub hop_period_s: f32,
@@ -28,6 +30,10 @@ pub struct CreatureDef {
     /// The rigid-body model (paper 3.1); a kind without one is never simulated rigid.
     #[serde(default)]
     pub rigid: Option<RigidConfig>,
+    /// The gait table file (relative to the assets folder) the hybrid level plays back
+    /// (paper 3.2), written by `simlod record-gait`; a kind without one is never hybrid.
+    #[serde(default)]
+    pub gait_table: Option<String>,
 }
 
 /// The rigid-body hopper of the paper's figure 2: a body, an upper leg on a three-axis hip

@@ -17,6 +17,8 @@ pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};
 
 use bevy::prelude::*;
+
+use crate::gait::GaitTable;
 use std::path::{Path, PathBuf};
 
 /// Everything one simulation run is built from: the scenario and the files it names.
@@ -26,6 +28,8 @@ pub struct SimConfig {
     pub arena: ArenaConfig,
     /// Creature definitions, indexed by [`crate::creature::Creature::kind`].
     pub kinds: Vec<CreatureDef>,
+    /// Each kind's gait table, if it has one (same index as `kinds`).
+    pub gaits: Vec<Option<GaitTable>>,
 }
 
 impl SimConfig {
@@ -63,7 +67,16 @@ impl SimConfig {
             }
             kinds.push(def);
         }
-        let config = Self { scenario, arena, kinds };
+        let gaits = kinds
+            .iter()
+            .map(|k| load_gait(assets_root, k))
+            .collect::<Result<_, _>>()?;
+        let config = Self {
+            scenario,
+            arena,
+            kinds,
+            gaits,
+        };
         config.check_fit(scenario_path)?;
         Ok(config)
     }
@@ -89,6 +102,21 @@ impl SimConfig {
         }
         Ok(())
     }
+}
+
+/// A kind's gait table, checked to be recorded for that kind.
+fn load_gait(assets_root: &Path, kind: &CreatureDef) -> Result<Option<GaitTable>, ConfigError> {
+    let Some(file) = &kind.gait_table else { return Ok(None) };
+    let path = assets_root.join(file);
+    let table: GaitTable = load_file(&path)?;
+    if table.creature != kind.name {
+        return Err(ConfigError::one(
+            &path,
+            "creature",
+            format!("the table was recorded for {:?}, not {:?}", table.creature, kind.name),
+        ));
+    }
+    Ok(Some(table))
 }
 
 /// The file a creature kind is defined in.

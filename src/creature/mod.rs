@@ -8,13 +8,14 @@ use std::ops::Index;
 
 use crate::WorldRng;
 use crate::config::{CreatureDef, RigidConfig, SimConfig, SteeringConfig};
+use crate::gait::{GaitPose, GaitTable};
 use crate::lod::Lod;
 use crate::outcome::CollisionRecord;
 use std::collections::HashMap;
 
 /// A legged creature. Its level of detail is the [`Lod`] component beside it.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
-#[require(Lod, PlanarState, GaitPhase, DesiredVelocity, CollisionRecord)]
+#[require(Lod, PlanarState, GaitPhase, GaitPose, DesiredVelocity, CollisionRecord)]
 pub struct Creature {
     /// Index into [`KindTable`] (and [`SimConfig::kinds`]).
     pub kind: usize,
@@ -71,8 +72,13 @@ pub struct DesiredVelocity(pub Vec2);
 pub struct KindParams {
     pub radius_m: f32,
     pub mass_kg: f32,
+    /// The point mass's limits: the gait table's measured ones when there is a table.
     pub top_speed_m_per_s: f32,
     pub acceleration_limit_m_per_s2: f32,
+    /// How fast the rigid model's command follows the desired velocity.
+    pub command_acceleration_m_per_s2: f32,
+    /// Standing pose: the point-mass level holds it (the leg straight down).
+    pub standing_pose: GaitPose,
     /// Hop cycles per second.
     pub cycles_per_s: f32,
     /// Part of the cycle before lift-off.
@@ -81,21 +87,41 @@ pub struct KindParams {
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
     pub rigid: Option<RigidConfig>,
+    pub gait: Option<GaitTable>,
 }
 
-impl From<&CreatureDef> for KindParams {
-    fn from(d: &CreatureDef) -> Self {
+impl KindParams {
+    /// The levels this kind has a model for.
+    pub fn levels(&self) -> Vec<Lod> {
+        Lod::ALL
+            .into_iter()
+            .filter(|l| match l {
+                Lod::PointMass => true,
+                Lod::Hybrid => self.gait.is_some(),
+                Lod::Rigid => self.rigid.is_some(),
+            })
+            .collect()
+    }
+
+    pub fn new(d: &CreatureDef, gait: Option<&GaitTable>) -> Self {
         Self {
             radius_m: d.body.radius_m,
             mass_kg: d.body.mass_kg,
-            top_speed_m_per_s: d.top_speed_m_per_s,
-            acceleration_limit_m_per_s2: d.acceleration_limit_m_per_s2,
+            top_speed_m_per_s: gait.map_or(d.top_speed_m_per_s, |g| g.top_speed_m_per_s),
+            acceleration_limit_m_per_s2: gait.map_or(d.acceleration_limit_m_per_s2, |g| g.acceleration_limit_m_per_s2),
+            command_acceleration_m_per_s2: d.acceleration_limit_m_per_s2,
+            standing_pose: GaitPose {
+                body_height_m: d.body.hip_height_m,
+                leg_length_m: d.body.hip_height_m,
+                ..default()
+            },
             cycles_per_s: 1.0 / d.hop_period_s,
             stance_fraction: 1.0 - d.flight_fraction,
             fall_impact_speed_m_per_s: d.fall_impact_speed_m_per_s,
             collision_restitution: d.collision_restitution,
             steering: d.steering.clone(),
             rigid: d.rigid.clone(),
+            gait: gait.cloned(),
         }
     }
 }
@@ -152,11 +178,12 @@ pub fn find_free_spot(
 /// What a new creature starts with, apart from where it stands.
 pub fn creature_bundle(
     kind: usize,
+    params: &KindParams,
     serial: u32,
     level: Lod,
     position: Vec2,
     rng: &mut WorldRng,
-) -> (Creature, Lod, PlanarState, GaitPhase) {
+) -> (Creature, Lod, PlanarState, GaitPhase, GaitPose) {
     let heading = Vec2::from_angle(rng.0.random_range(-std::f32::consts::PI..std::f32::consts::PI));
     let cycle = rng.0.random_range(0.0..1.0);
     (
@@ -171,6 +198,7 @@ pub fn creature_bundle(
             cycle,
             in_flight: false,
         },
+        params.standing_pose,
     )
 }
 
@@ -211,6 +239,7 @@ impl Occupancy {
 fn spawn_creatures(
     mut commands: Commands,
     config: Res<SimConfig>,
+    kinds: Res<KindTable>,
     mut rng: ResMut<WorldRng>,
     mut serials: ResMut<SerialCounter>,
 ) {
@@ -228,29 +257,34 @@ fn spawn_creatures(
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
-        let level = config
-            .scenario
-            .level_policy
-            .initial_level(config.kinds[kind].rigid.is_some());
+        let level = config.scenario.level_policy.initial_level(kinds[kind].levels());
         for _ in 0..group.count {
             // The puck starts at the centre.
             let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {
                 placed.clearance(p).min(p.length() - puck_keep_out)
             });
             placed.insert(spot, radius);
-            batch.push(creature_bundle(kind, serials.take(), level, spot, &mut rng));
+            batch.push(creature_bundle(
+                kind,
+                &kinds[kind],
+                serials.take(),
+                level,
+                spot,
+                &mut rng,
+            ));
         }
     }
     commands.spawn_batch(batch);
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let config = app.world().resource::<SimConfig>();
     let kinds = KindTable(
-        app.world()
-            .resource::<SimConfig>()
+        config
             .kinds
             .iter()
-            .map(KindParams::from)
+            .zip(&config.gaits)
+            .map(|(d, g)| KindParams::new(d, g.as_ref()))
             .collect(),
     );
     app.insert_resource(kinds)

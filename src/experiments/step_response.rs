@@ -111,7 +111,10 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
             experiment.creature
         ));
     }
-    let traces = [trace(sim_config, &experiment, "rigid", LevelPolicy::AllRigid)];
+    let traces = [
+        trace(sim_config, &experiment, "rigid", LevelPolicy::AllRigid),
+        trace(sim_config, &experiment, "hybrid", LevelPolicy::AllHybrid),
+    ];
     let mut velocity = String::from(
         "model,t_s,desired_vx_m_per_s,desired_vz_m_per_s,vx_m_per_s,vz_m_per_s,desired_speed_m_per_s,speed_m_per_s\n",
     );
@@ -141,6 +144,18 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
             tr.samples.last().map_or(0.0, |s| s.0),
             end.x,
             end.y
+        );
+    }
+    let ends: Vec<Vec2> = traces
+        .iter()
+        .filter_map(|tr| tr.samples.last().map(|s| s.2.position))
+        .collect();
+    if let [rigid, hybrid] = ends[..] {
+        let _ = writeln!(
+            summary,
+            "after {:.1} s the models are {:.3} m apart",
+            experiment.duration_s,
+            rigid.distance(hybrid)
         );
     }
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;

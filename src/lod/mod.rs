@@ -1,30 +1,41 @@
 //! Simulation levels of detail (paper section 3): the level each creature is simulated at,
 //! and the policy that picks it.
 //!
-//! Only levels with a working model behind them exist. The point-mass level (section 3.3) is
-//! here; the hybrid and rigid levels arrive with their models.
+//! Only levels with a working model behind them exist: the point mass (section 3.3), the
+//! hybrid (3.2) and the rigid body (3.1).
 
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// The level of detail a creature is simulated at.
+/// The level of detail a creature is simulated at; ordered from the cheapest to the most
+/// detailed.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum Lod {
     /// A point mass on the plane with an acceleration limit; the leg held at a constant
     /// angle (section 3.3).
     #[default]
     PointMass,
+    /// The same point mass, with the body and leg posed from the gait table recorded from the
+    /// rigid model (section 3.2).
+    Hybrid,
     /// Rapier rigid bodies and joints driven by Raibert's controller (section 3.1).
     Rigid,
 }
 
 impl Lod {
-    pub const ALL: [Lod; 2] = [Lod::PointMass, Lod::Rigid];
+    /// From the cheapest to the most detailed.
+    pub const ALL: [Lod; 3] = [Lod::PointMass, Lod::Hybrid, Lod::Rigid];
+
+    /// The point-mass and hybrid levels share one planar body (and its collisions).
+    pub fn moves_as_point_mass(self) -> bool {
+        self != Lod::Rigid
+    }
 
     /// The name used in summaries and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Lod::PointMass => "point_mass",
+            Lod::Hybrid => "hybrid",
             Lod::Rigid => "rigid",
         }
     }
@@ -36,17 +47,47 @@ pub enum LevelPolicy {
     /// Every creature at the point-mass level.
     #[default]
     AllPointMass,
-    /// Every creature whose kind has a rigid model at the rigid level; the others at the
-    /// point-mass level.
+    /// Every creature at the hybrid level.
+    AllHybrid,
+    /// Every creature at the rigid level.
     AllRigid,
 }
 
 impl LevelPolicy {
-    /// The level a newly spawned creature of a kind starts at.
-    pub fn initial_level(self, has_rigid_model: bool) -> Lod {
-        match self {
-            LevelPolicy::AllRigid if has_rigid_model => Lod::Rigid,
-            LevelPolicy::AllPointMass | LevelPolicy::AllRigid => Lod::PointMass,
-        }
+    /// The level a creature starts at, given the levels its kind has models for: the policy's
+    /// level, or the most detailed one below it that the kind has.
+    pub fn initial_level(self, available: Vec<Lod>) -> Lod {
+        let wanted = match self {
+            LevelPolicy::AllPointMass => Lod::PointMass,
+            LevelPolicy::AllHybrid => Lod::Hybrid,
+            LevelPolicy::AllRigid => Lod::Rigid,
+        };
+        available
+            .into_iter()
+            .filter(|&l| l <= wanted)
+            .max()
+            .unwrap_or(Lod::PointMass)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_kind_without_the_wanted_model_gets_the_most_detailed_level_below_it() {
+        assert_eq!(
+            LevelPolicy::AllRigid.initial_level(vec![Lod::PointMass, Lod::Hybrid]),
+            Lod::Hybrid
+        );
+        assert_eq!(
+            LevelPolicy::AllRigid.initial_level(vec![Lod::PointMass]),
+            Lod::PointMass
+        );
+        assert_eq!(LevelPolicy::AllHybrid.initial_level(Lod::ALL.to_vec()), Lod::Hybrid);
+        assert_eq!(
+            LevelPolicy::AllPointMass.initial_level(Lod::ALL.to_vec()),
+            Lod::PointMass
+        );
     }
 }

@@ -1,5 +1,6 @@
 //! Step: the model behind each level of detail.
 
+pub mod hybrid;
 pub mod point_mass;
 pub mod rigid;
 

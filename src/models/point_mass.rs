@@ -1,11 +1,14 @@
 //! The point-mass model (paper section 3.3): the body's position on the plane integrated
 //! with an acceleration limit and a top speed; the body faces its direction of travel; the
-//! leg is held at a constant angle, so there is nothing of it to compute.
+//! leg is held at a constant angle (the kind's standing pose), so there is nothing of it to
+//! compute. The hybrid level (3.2) is this same model plus the gait table.
 
 use bevy::prelude::*;
 
+use super::hybrid;
 use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
+use crate::gait::GaitPose;
 use crate::lod::Lod;
 use crate::{SimClock, SimStage};
 
@@ -30,11 +33,19 @@ pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, dt: f32) {
     gait.in_flight = gait.cycle >= kind.stance_fraction;
 }
 
+/// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
 fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
-    mut creatures: Query<(&Creature, &Lod, &DesiredVelocity, &mut PlanarState, &mut GaitPhase)>,
+    mut creatures: Query<(
+        &Creature,
+        &Lod,
+        &DesiredVelocity,
+        &mut PlanarState,
+        &mut GaitPhase,
+        &mut GaitPose,
+    )>,
 ) {
     let dt = clock.dt;
     for_each_creature!(config.scenario.creature_count(), creatures, |(
@@ -43,17 +54,26 @@ fn step_point_masses(
         desired,
         mut state,
         mut gait,
+        mut pose,
     ): (
         &Creature,
         &Lod,
         &DesiredVelocity,
         Mut<PlanarState>,
-        Mut<GaitPhase>
+        Mut<GaitPhase>,
+        Mut<GaitPose>
     )| {
-        if *lod == Lod::PointMass {
-            let kind = &kinds[creature.kind];
-            step_planar(&mut state, desired.0, kind, dt);
-            advance_gait(&mut gait, kind, dt);
+        let kind = &kinds[creature.kind];
+        match (lod, &kind.gait) {
+            (Lod::PointMass, _) => {
+                step_planar(&mut state, desired.0, kind, dt);
+                advance_gait(&mut gait, kind, dt);
+            }
+            (Lod::Hybrid, Some(table)) => {
+                step_planar(&mut state, desired.0, kind, dt);
+                hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), dt);
+            }
+            _ => {}
         }
     });
 }
@@ -77,6 +97,8 @@ mod tests {
             stance_fraction: 0.4,
             fall_impact_speed_m_per_s: 2.0,
             collision_restitution: 0.0,
+            command_acceleration_m_per_s2: 2.0,
+            standing_pose: GaitPose::default(),
             steering: SteeringConfig {
                 cruise_speed_m_per_s: 1.0,
                 wander_turn_rad_per_s: 0.0,
@@ -89,6 +111,7 @@ mod tests {
                 separation_weight: 0.0,
             },
             rigid: None,
+            gait: None,
         }
     }
 

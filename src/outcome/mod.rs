@@ -1,7 +1,7 @@
 //! Observe and Outcome: collisions, falls, respawns and the counts the paper's experiments
 //! read (figure 10 counts the creatures that collided with the puck or a wall).
 //!
-//! What a collision does at the point-mass level, where there is no balance to lose: the
+//! What a collision does at the point-mass and hybrid levels, where there is no balance to lose: the
 //! bodies are pushed apart and the normal part of their relative velocity is removed (kept
 //! in part by the creature's `collision_restitution`). The puck is far heavier and is not
 //! slowed; it shoves the creature along. A creature falls when the normal speed of an impact
@@ -189,7 +189,7 @@ fn detect_collisions(
         Mut<PlanarState>,
         Mut<CollisionRecord>
     )| {
-        if *lod != Lod::PointMass {
+        if !lod.moves_as_point_mass() {
             return;
         }
         let kind = &kinds[creature.kind];
@@ -204,6 +204,7 @@ fn detect_collisions(
 fn respawn_fallen(
     mut commands: Commands,
     config: Res<SimConfig>,
+    kinds: Res<KindTable>,
     puck: Res<PuckState>,
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
@@ -238,7 +239,14 @@ fn respawn_fallen(
                 .min(p.distance(puck.position) - puck_keep_out)
         });
         commands.entity(entity).despawn();
-        commands.spawn(creature_bundle(creature.kind, serials.take(), *lod, spot, &mut rng));
+        commands.spawn(creature_bundle(
+            creature.kind,
+            &kinds[creature.kind],
+            serials.take(),
+            *lod,
+            spot,
+            &mut rng,
+        ));
     }
 }
 

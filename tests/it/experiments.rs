@@ -8,7 +8,11 @@ fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
     let out = scratch_dir("step_response");
     let file = assets_root().join("experiments/step_response.ron");
     let summary = step_response::run(&default_config(), &file, &out).unwrap();
-    assert!(summary.contains("rigid: 240 samples"), "{summary}");
+    assert!(
+        summary.contains("rigid: 240 samples") && summary.contains("hybrid: 240 samples"),
+        "{summary}"
+    );
+    assert!(summary.contains("the models are"), "{summary}");
     let velocity = std::fs::read_to_string(out.join("velocity.csv")).unwrap();
     let path = std::fs::read_to_string(out.join("path.csv")).unwrap();
     assert_eq!(velocity.lines().count(), 241);

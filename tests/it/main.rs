@@ -5,6 +5,7 @@ mod assets;
 mod court;
 mod determinism;
 mod experiments;
+mod gait;
 mod outcome;
 mod rigid;
 mod steering;

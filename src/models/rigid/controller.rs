@@ -278,7 +278,7 @@ pub(super) fn control_hoppers(
             continue;
         }
         let kind = &kinds[creature.kind];
-        let step = (desired.0 - raibert.command).clamp_length_max(kind.acceleration_limit_m_per_s2 * clock.dt);
+        let step = (desired.0 - raibert.command).clamp_length_max(kind.command_acceleration_m_per_s2 * clock.dt);
         raibert.command += step;
         let command = raibert.command;
         let target = raibert.update_phase(&sensed, r, command, now);

@@ -16,6 +16,7 @@ use bevy_rapier3d::prelude::*;
 use crate::arena::{Ground, Puck, Wall};
 use crate::config::RigidConfig;
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
+use crate::gait::GaitPose;
 use crate::lod::Lod;
 use crate::outcome::{CollisionRecord, FallQueue, Obstacle};
 use crate::{SimClock, SimStage};
@@ -146,6 +147,21 @@ pub fn spawn_hopper(
     }
 }
 
+/// The body and leg pose of a rigid hopper, in the frame of its heading.
+pub fn rigid_pose(body: &Transform, foot: &Transform) -> GaitPose {
+    let (_, pitch, roll) = body.rotation.to_euler(EulerRot::YZX);
+    let to_foot = foot.translation - body.translation;
+    let leg = body.rotation.inverse() * to_foot;
+    GaitPose {
+        body_height_m: body.translation.y,
+        roll_rad: roll,
+        pitch_rad: pitch,
+        leg_length_m: to_foot.length(),
+        leg_forward_rad: leg.x.atan2(-leg.y),
+        leg_sideways_rad: (-leg.z).atan2(-leg.y),
+    }
+}
+
 /// Gives every rigid creature without bodies its bodies and a fresh controller.
 fn build_bodies(
     mut commands: Commands,
@@ -189,13 +205,14 @@ fn observe_hoppers(
         &Raibert,
         &mut PlanarState,
         &mut GaitPhase,
+        &mut GaitPose,
         &mut CollisionRecord,
     )>,
     parts: Query<(&Transform, &Velocity, &CollidingEntities)>,
     obstacles: Query<(Has<Puck>, Has<Wall>, Has<Ground>, Option<&RigidPart>)>,
 ) {
     let now = clock.seconds() as f32;
-    for (entity, creature, hopper, raibert, mut state, mut gait, mut record) in &mut creatures {
+    for (entity, creature, hopper, raibert, mut state, mut gait, mut pose, mut record) in &mut creatures {
         let Some(r) = &kinds[creature.kind].rigid else { continue };
         let Ok((body, body_velocity, _)) = parts.get(hopper.body) else {
             continue;
@@ -205,6 +222,9 @@ fn observe_hoppers(
         state.velocity = body_velocity.linear.xz();
         state.heading = forward.xz().try_normalize().unwrap_or(state.heading);
         *gait = raibert.gait_phase(now);
+        if let Ok((foot, _, _)) = parts.get(hopper.lower_leg) {
+            *pose = rigid_pose(body, foot);
+        }
 
         let mut touching = [false; 3];
         let mut body_on_ground = false;

@@ -1,0 +1,225 @@
+//! `simlod record-gait`: records a gait table from the rigid model (paper 3.2: "we recorded
+//! motion from the dynamic simulation with forward velocities of 0, 1, 2, and 3 m/s ... at a
+//! rate of 30 samples/second for the period of time from one touchdown to the next").
+//!
+//! At each speed the rigid hopper runs until its gait is steady, then several hops are each
+//! resampled at 30 Hz from touchdown and averaged. A second run from standing to the top
+//! speed measures the acceleration the point mass must match. The world is seeded, so the
+//! same files give the same table.
+
+use bevy::prelude::*;
+use std::fmt::Write as _;
+
+use super::{COLUMNS, GaitPose, GaitRow, GaitTable};
+use crate::config::SimConfig;
+use crate::creature::{DesiredVelocity, PlanarState};
+use crate::experiments::lone_creature;
+use crate::headless::HeadlessSim;
+use crate::lod::LevelPolicy;
+use crate::models::rigid::{Raibert, RigidHopper, rigid_pose};
+
+/// How a table is recorded.
+#[derive(Clone, Debug)]
+pub struct RecordSettings {
+    /// Steady forward speeds to record, increasing.
+    pub speeds_m_per_s: Vec<f32>,
+    /// Running time before recording starts at each speed.
+    pub settle_s: f32,
+    /// Hops averaged per speed.
+    pub hops: usize,
+    pub sample_hz: f32,
+}
+
+impl Default for RecordSettings {
+    fn default() -> Self {
+        Self {
+            speeds_m_per_s: vec![0.0, 1.0, 2.0, 3.0],
+            settle_s: 15.0,
+            hops: 4,
+            sample_hz: 30.0,
+        }
+    }
+}
+
+/// One tick's record of a running hopper.
+#[derive(Clone, Copy)]
+struct Tick {
+    t: f32,
+    pose: GaitPose,
+    position: Vec2,
+    liftoff_s: f32,
+}
+
+/// A hopper commanded at `speed` along +x, stepped one tick per update.
+fn runner(config: &SimConfig, kind: &str, speed: f32) -> (HeadlessSim, Entity) {
+    let mut config = config.clone();
+    config.scenario.decision_hz = config.scenario.tick_hz;
+    let (mut sim, hopper) = lone_creature(&config, kind, LevelPolicy::AllRigid, Vec2::new(-140.0, 0.0), 300.0);
+    sim.app
+        .world_mut()
+        .entity_mut(hopper)
+        .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+    (sim, hopper)
+}
+
+fn sample(sim: &mut HeadlessSim, hopper: Entity) -> Result<(Tick, f32), String> {
+    let world = sim.app.world();
+    let fell = || format!("the rigid hopper fell at {:.2} s", sim.clock().seconds());
+    let raibert = world.get::<Raibert>(hopper).ok_or_else(fell)?;
+    let parts = world.get::<RigidHopper>(hopper).ok_or_else(fell)?;
+    let state = world.get::<PlanarState>(hopper).ok_or_else(fell)?;
+    let body = world.get::<Transform>(parts.body).ok_or_else(fell)?;
+    let foot = world.get::<Transform>(parts.lower_leg).ok_or_else(fell)?;
+    let pose = rigid_pose(body, foot);
+    let tick = Tick {
+        t: sim.clock().seconds() as f32,
+        pose,
+        position: state.position,
+        liftoff_s: raibert.last_liftoff_s,
+    };
+    Ok((tick, raibert.last_touchdown_s))
+}
+
+/// Records `hops` steady hops at `speed` and averages them into a row.
+fn record_row(config: &SimConfig, kind: &str, speed: f32, s: &RecordSettings) -> Result<GaitRow, String> {
+    let (mut sim, hopper) = runner(config, kind, speed);
+    sim.run_for(f64::from(s.settle_s));
+    let mut ticks: Vec<Tick> = Vec::new();
+    let mut touchdowns: Vec<f32> = Vec::new();
+    let (_, mut last) = sample(&mut sim, hopper)?;
+    while touchdowns.len() <= s.hops {
+        sim.advance_frame();
+        let (tick, touchdown) = sample(&mut sim, hopper)?;
+        if touchdown != last {
+            touchdowns.push(touchdown);
+            last = touchdown;
+        }
+        if !touchdowns.is_empty() {
+            ticks.push(tick);
+        }
+        if sim.clock().seconds() > f64::from(s.settle_s) + 10.0 {
+            return Err(format!(
+                "no steady hopping at {speed} m/s: {} touchdowns in 10 s",
+                touchdowns.len()
+            ));
+        }
+    }
+    let hops: Vec<(f32, f32)> = touchdowns.windows(2).map(|w| (w[0], w[1])).collect();
+    let period = hops.iter().map(|(a, b)| b - a).sum::<f32>() / hops.len() as f32;
+    let n = (period * s.sample_hz).ceil() as usize;
+    let mut sums = vec![[0.0f32; 6]; n];
+    let mut stance = 0.0;
+    for &(start, end) in &hops {
+        for (k, sum) in sums.iter_mut().enumerate() {
+            // The same share of each hop as sample k is of the mean hop.
+            let t = start + (k as f32 / s.sample_hz) / period * (end - start);
+            let row = pose_at(&ticks, t).to_row();
+            for (acc, x) in sum.iter_mut().zip(row) {
+                *acc += x;
+            }
+        }
+        let liftoff = ticks
+            .iter()
+            .find(|tk| tk.t > start && tk.liftoff_s > start)
+            .map_or(end, |tk| tk.liftoff_s);
+        stance += (liftoff - start) / (end - start);
+    }
+    let count = hops.len() as f32;
+    let at = |t: f32| ticks.iter().find(|tk| tk.t >= t).map_or(Vec2::ZERO, |tk| tk.position);
+    let (first, last) = (hops[0].0, hops[hops.len() - 1].1);
+    Ok(GaitRow {
+        speed_m_per_s: (at(last) - at(first)).length() / (last - first),
+        hop_period_s: period,
+        stance_fraction: stance / count,
+        samples: sums
+            .into_iter()
+            .map(|sum| sum.iter().map(|x| x / count).collect())
+            .collect(),
+    })
+}
+
+/// The recorded pose at time `t`, interpolated between ticks.
+fn pose_at(ticks: &[Tick], t: f32) -> GaitPose {
+    let i = ticks.partition_point(|tk| tk.t < t).clamp(1, ticks.len() - 1);
+    let (a, b) = (ticks[i - 1], ticks[i]);
+    let w = ((t - a.t) / (b.t - a.t).max(1e-6)).clamp(0.0, 1.0);
+    let (ra, rb) = (a.pose.to_row(), b.pose.to_row());
+    let r: Vec<f32> = ra.iter().zip(rb).map(|(x, y)| x + (y - x) * w).collect();
+    GaitPose {
+        body_height_m: r[0],
+        roll_rad: r[1],
+        pitch_rad: r[2],
+        leg_length_m: r[3],
+        leg_forward_rad: r[4],
+        leg_sideways_rad: r[5],
+    }
+}
+
+/// From standing, commanded to `top`: the acceleration of the hop-averaged speed while it
+/// rises from 10 % to 70 % of `top` (the saturated part a limit describes).
+fn measure_acceleration(config: &SimConfig, kind: &str, top: f32) -> Result<f32, String> {
+    let (mut sim, hopper) = runner(config, kind, 0.0);
+    sim.run_for(3.0);
+    let start = sim.clock().seconds() as f32;
+    sim.app
+        .world_mut()
+        .entity_mut(hopper)
+        .insert(DesiredVelocity(Vec2::new(top, 0.0)));
+    let (_, mut last) = sample(&mut sim, hopper)?;
+    let mut previous: Option<(f32, Vec2)> = None;
+    let mut rising_from: Option<(f32, f32)> = None;
+    while sim.clock().seconds() < f64::from(start) + 20.0 {
+        sim.advance_frame();
+        let (tick, touchdown) = sample(&mut sim, hopper)?;
+        if touchdown == last {
+            continue;
+        }
+        last = touchdown;
+        if let Some((t0, p0)) = previous {
+            // The hop-averaged speed belongs to the middle of the hop.
+            let (t, speed) = ((t0 + tick.t) / 2.0, (tick.position.x - p0.x) / (tick.t - t0));
+            match rising_from {
+                None if speed >= 0.1 * top => rising_from = Some((t, speed)),
+                Some((ta, va)) if speed >= 0.7 * top => return Ok((speed - va) / (t - ta)),
+                _ => {}
+            }
+        }
+        previous = Some((tick.t, tick.position));
+    }
+    Err(format!("the rigid hopper never reached 70 % of {top} m/s in 20 s"))
+}
+
+/// Records the table of `kind` (which must have a rigid model in `config`).
+pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Result<GaitTable, String> {
+    let rows = settings
+        .speeds_m_per_s
+        .iter()
+        .map(|&v| record_row(config, kind, v, settings))
+        .collect::<Result<Vec<_>, _>>()?;
+    let top = rows.iter().map(|r| r.speed_m_per_s).fold(0.0, f32::max);
+    Ok(GaitTable {
+        creature: kind.to_owned(),
+        sample_hz: settings.sample_hz,
+        columns: COLUMNS.iter().map(|c| (*c).to_owned()).collect(),
+        acceleration_limit_m_per_s2: measure_acceleration(config, kind, top)?,
+        top_speed_m_per_s: top,
+        rows,
+    })
+}
+
+/// The table as a RON file, with a header saying how it was made.
+pub fn to_file_text(table: &GaitTable, command: &str) -> String {
+    let pretty = ron::ser::PrettyConfig::new().depth_limit(4).struct_names(false);
+    let body = ron::ser::to_string_pretty(table, pretty).expect("a gait table serialises");
+    let mut text = String::new();
+    let _ = writeln!(text, "// Gait table recorded from the rigid model by:");
+    let _ = writeln!(text, "//     {command}");
+    let _ = writeln!(
+        text,
+        "// Do not edit by hand: run the command again (same files, same table)."
+    );
+    let _ = writeln!(text, "// Columns of each sample: {}.", COLUMNS.join(", "));
+    text.push_str(&body);
+    text.push('\n');
+    text
+}

@@ -1,0 +1,164 @@
+//! The gait table and the hybrid level (paper 3.2).
+
+use bevy::prelude::*;
+
+use crate::support::*;
+use simlod::config::{ConfigError, SimConfig, load_file};
+use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
+use simlod::experiments::lone_creature;
+use simlod::gait::record::{RecordSettings, record, to_file_text};
+use simlod::gait::{GaitPose, GaitTable};
+use simlod::lod::LevelPolicy;
+use simlod::models::rigid::Raibert;
+
+const SHIPPED: &str = "gaits/hopper.ron";
+const COMMAND: &str = "simlod record-gait --creature assets/creatures/hopper.ron --speeds 0,1,2,3";
+
+#[test]
+fn recording_again_reproduces_the_shipped_table() {
+    let mut config = default_config();
+    let hopper = config.kind_index("hopper").unwrap();
+    config.gaits[hopper] = None; // as record-gait does: never from an earlier table
+    let table = record(&config, "hopper", &RecordSettings::default()).unwrap();
+    let shipped = std::fs::read_to_string(assets_root().join(SHIPPED)).unwrap();
+    assert!(
+        shipped.contains(COMMAND),
+        "the shipped table's header names the command that made it"
+    );
+    assert_eq!(to_file_text(&table, COMMAND), shipped);
+}
+
+#[test]
+fn the_table_matches_the_rigid_models_measured_limits() {
+    let table = &default_config().gaits[0].clone().unwrap();
+    assert_eq!(table.rows.len(), 4);
+    // The rigid hopper really runs near 3 m/s and its hop rhythm barely changes with speed
+    // (the paper's reason why interpolating the table works).
+    assert!(
+        table.top_speed_m_per_s > 2.5 && table.top_speed_m_per_s < 3.2,
+        "{}",
+        table.top_speed_m_per_s
+    );
+    let periods: Vec<f32> = table.rows.iter().map(|r| r.hop_period_s).collect();
+    let (lo, hi) = (
+        periods.iter().cloned().fold(f32::MAX, f32::min),
+        periods.iter().cloned().fold(0.0, f32::max),
+    );
+    assert!(hi / lo < 1.15, "hop periods {periods:?}");
+    assert!(table.acceleration_limit_m_per_s2 > 0.3 && table.acceleration_limit_m_per_s2 < 3.0);
+}
+
+fn broken(test: &str, edit: impl Fn(&str) -> String) -> ConfigError {
+    let dir = scratch_dir(test);
+    let file = dir.join("gait.ron");
+    let text = std::fs::read_to_string(assets_root().join(SHIPPED)).unwrap();
+    std::fs::write(&file, edit(&text)).unwrap();
+    load_file::<GaitTable>(&file).unwrap_err()
+}
+
+#[test]
+fn a_sample_row_of_another_length_is_named() {
+    let err = broken("gait_row_length", |t| {
+        t.replacen("0.000047625155, 0.000018450859]", "0.000047625155]", 1)
+    });
+    let text = err.to_string();
+    assert!(
+        text.contains("gait.ron") && text.contains("`rows[0].samples[0]`") && text.contains("has 5 values"),
+        "{text}"
+    );
+}
+
+#[test]
+fn speeds_out_of_order_are_refused() {
+    let err = broken("gait_order", |t| {
+        t.replacen("speed_m_per_s: 1.", "speed_m_per_s: 9.", 1)
+    });
+    assert!(err.to_string().contains("increasing order"), "{err}");
+}
+
+#[test]
+fn a_nan_in_the_table_is_named() {
+    let err = broken("gait_nan", |t| t.replacen("[0.78908867,", "[NaN,", 1));
+    let text = err.to_string();
+    assert!(
+        text.contains("`rows[0].samples[0]`") && text.contains("body_height_m is NaN"),
+        "{text}"
+    );
+}
+
+#[test]
+fn an_empty_table_is_refused() {
+    let err = broken("gait_empty", |t| {
+        let start = t.find("rows: [").unwrap();
+        format!("{}rows: [],\n)", &t[..start])
+    });
+    assert!(err.to_string().contains("the table is empty"), "{err}");
+}
+
+/// Runs a rigid and a hybrid hopper side by side at `speed` and compares their poses at the
+/// same phase of the hop, once settled.
+fn pose_gap(speed: f32) -> (f32, f32, f32) {
+    let config: SimConfig = default_config();
+    let start = Vec2::new(-180.0, 0.0);
+    let mut runners: Vec<_> = [LevelPolicy::AllRigid, LevelPolicy::AllHybrid]
+        .into_iter()
+        .map(|policy| {
+            let (mut sim, e) = lone_creature(&config, "hopper", policy, start, 420.0);
+            sim.app
+                .world_mut()
+                .entity_mut(e)
+                .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+            sim.run_for(12.0);
+            (sim, e)
+        })
+        .collect();
+    let table = config.gaits[0].clone().unwrap();
+    let (mut height, mut pitch, mut leg) = (0.0f32, 0.0f32, 0.0f32);
+    for _ in 0..90 {
+        for (sim, _) in &mut runners {
+            sim.advance_frame();
+        }
+        // The rigid hopper's phase, measured; the table's pose at that phase and speed.
+        let (sim, e) = &runners[0];
+        let world = sim.app.world();
+        let raibert = world.get::<Raibert>(*e).expect("the rigid hopper is standing");
+        let now = sim.clock().seconds() as f32;
+        let rigid = *world.get::<GaitPose>(*e).unwrap();
+        let phase = raibert.gait_phase(now).cycle;
+        let speed_now = world.get::<PlanarState>(*e).unwrap().velocity.length();
+        let played = table.pose(speed_now, phase);
+        height = height.max((rigid.body_height_m - played.body_height_m).abs());
+        pitch = pitch.max((rigid.pitch_rad - played.pitch_rad).abs());
+        leg = leg.max((rigid.leg_forward_rad - played.leg_forward_rad).abs());
+        // And the hybrid creature itself plays the same table.
+        let (sim, e) = &runners[1];
+        let world = sim.app.world();
+        let (g, p) = (world.get::<GaitPhase>(*e).unwrap(), world.get::<GaitPose>(*e).unwrap());
+        let s = world.get::<PlanarState>(*e).unwrap();
+        assert_eq!(*p, table.pose(s.velocity.length(), g.cycle));
+    }
+    (height, pitch.to_degrees(), leg.to_degrees())
+}
+
+#[test]
+fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
+    // What a viewer sees of a hopper 0.8 m tall: a few centimetres of height and a few
+    // degrees of body or leg angle are invisible at game distances; the hop itself is 25 cm
+    // and the leg swings 25 degrees.
+    for speed in [0.0, 1.5, 2.0] {
+        let (height, pitch, leg) = pose_gap(speed);
+        eprintln!("{speed} m/s: largest gaps: height {height:.4} m, pitch {pitch:.2} deg, leg {leg:.2} deg");
+        assert!(height < 0.05, "{speed} m/s: body height off by {height} m");
+        assert!(pitch < 5.0, "{speed} m/s: pitch off by {pitch} degrees");
+        assert!(leg < 8.0, "{speed} m/s: leg angle off by {leg} degrees");
+    }
+}
+
+#[test]
+fn the_default_scenario_runs_all_hybrid() {
+    let mut config = default_config();
+    config.scenario.level_policy = LevelPolicy::AllHybrid;
+    let summary = simlod::headless::run(config, 10.0);
+    assert_eq!(summary.levels["hybrid"], 30, "hoppers have a gait table");
+    assert_eq!(summary.levels["point_mass"], 10, "bipeds have none yet");
+}
