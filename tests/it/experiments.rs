@@ -15,19 +15,36 @@ fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
     assert!(summary.contains("the models are"), "{summary}");
     let velocity = std::fs::read_to_string(out.join("velocity.csv")).unwrap();
     let path = std::fs::read_to_string(out.join("path.csv")).unwrap();
-    assert_eq!(velocity.lines().count(), 241);
-    assert_eq!(path.lines().count(), 241);
-    // The 2 m/s step at 1 s: by 3.5 s the hopper has sped up past 1.5 m/s along x.
-    let vx_at = |t: f32| -> f32 {
+    assert_eq!(velocity.lines().count(), 1 + 2 * 240);
+    assert_eq!(path.lines().count(), 1 + 2 * 240);
+    let vx_at = |model: &str, t: f32| -> f32 {
         let row = velocity
             .lines()
             .skip(1)
+            .filter(|l| l.starts_with(model))
             .find(|l| l.split(',').nth(1).unwrap().parse::<f32>().unwrap() >= t)
             .unwrap();
         row.split(',').nth(4).unwrap().parse().unwrap()
     };
-    assert!(vx_at(0.9).abs() < 0.05, "still at rest before the first step");
-    assert!(vx_at(3.45) > 1.5, "sped up after the step: {}", vx_at(3.45));
+    for model in ["rigid", "hybrid"] {
+        // The 2 m/s step at 1 s: still at rest before it, past 1.5 m/s by 3.5 s.
+        assert!(
+            vx_at(model, 0.9).abs() < 0.05,
+            "{model} still at rest before the first step"
+        );
+        assert!(
+            vx_at(model, 3.45) > 1.5,
+            "{model} sped up after the step: {}",
+            vx_at(model, 3.45)
+        );
+    }
+    // Figure 3: the hybrid responds to the step with less delay.
+    assert!(
+        vx_at("hybrid", 1.5) > vx_at("rigid", 1.5),
+        "{} vs {}",
+        vx_at("hybrid", 1.5),
+        vx_at("rigid", 1.5)
+    );
 }
 
 #[test]
