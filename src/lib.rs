@@ -10,6 +10,8 @@
 //! |---|---|---|
 //! | [`SimStage::Sense`] | [`sense`] | spatial index of creatures; the puck's state |
 //! | [`SimStage::Steer`] | [`creature::steering`] | desired velocity: flee the puck, avoid walls and others |
+//! | [`SimStage::SelectLod`] | [`lod`] | the level each creature should be at: influence areas, camera rule |
+//! | [`SimStage::Switch`] | [`lod`] | a change of level, inside the flight-phase window |
 //! | [`SimStage::Step`] | [`models`] | the model of each creature's level |
 //! | rapier's `PhysicsSet`s | [`arena`] | the puck and walls (rapier bodies) |
 //! | [`SimStage::Observe`] | [`outcome`] | collisions with the puck, walls and other creatures |
@@ -56,6 +58,8 @@ use config::SimConfig;
 pub enum SimStage {
     Sense,
     Steer,
+    SelectLod,
+    Switch,
     Step,
     Observe,
     Outcome,
@@ -118,7 +122,13 @@ impl Plugin for SimPlugin {
             .add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
             .configure_sets(
                 FixedUpdate,
-                (SimStage::Sense, SimStage::Steer, SimStage::Step)
+                (
+                    SimStage::Sense,
+                    SimStage::Steer,
+                    SimStage::SelectLod,
+                    SimStage::Switch,
+                    SimStage::Step,
+                )
                     .chain()
                     .before(PhysicsSet::SyncBackend),
             )
@@ -137,6 +147,7 @@ impl Plugin for SimPlugin {
         gait::plugin(app);
         arena::plugin(app);
         creature::plugin(app);
+        lod::plugin(app);
         sense::plugin(app);
         models::plugin(app);
         outcome::plugin(app);

@@ -156,6 +156,21 @@ struct ScenarioArgs {
     /// Overrides the scenario's level policy.
     #[arg(long, value_enum)]
     policy: Option<LevelPolicy>,
+    /// Overrides the radius of the puck's area of influence (metres).
+    #[arg(long, value_parser = non_negative_metres)]
+    puck_radius: Option<f32>,
+    /// Overrides the camera's radius of influence (metres).
+    #[arg(long, value_parser = non_negative_metres)]
+    camera_radius: Option<f32>,
+}
+
+fn non_negative_metres(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if v.is_finite() && (0.0..=1e4).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be between 0 and 10000 metres, got {v}"))
+    }
 }
 
 impl ScenarioArgs {
@@ -166,6 +181,12 @@ impl ScenarioArgs {
         }
         if let Some(policy) = self.policy {
             config.scenario.level_policy = policy;
+        }
+        if let Some(r) = self.puck_radius {
+            config.rules.influence.puck_radius_m = r;
+        }
+        if let Some(r) = self.camera_radius {
+            config.rules.camera.radius_m = r;
         }
         Ok(config)
     }
@@ -224,7 +245,15 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         s.creatures_collided
     );
     println!("falls: {}, respawns: {}", s.falls, s.respawns);
-    println!("creatures per level: {}", join(&s.levels));
+    println!("creatures per level at the end: {}", join(&s.levels));
+    let mean: Vec<String> = s
+        .levels_mean
+        .iter()
+        .map(|(k, v)| format!("{k} {v:.1} (peak {})", s.levels_peak[k]))
+        .collect();
+    println!("creatures per level on average: {}", mean.join(", "));
+    let switches: Vec<String> = s.switches.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    println!("level switches: {}", switches.join(", "));
 }
 
 fn main() -> ExitCode {

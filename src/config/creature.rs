@@ -17,6 +17,8 @@ pub struct CreatureDef {
     /// How fast the creature may change its velocity: the rigid model's command follows the
     /// desired velocity at this rate; the point mass uses it when there is no gait table.
     pub acceleration_limit_m_per_s2: f32,
+    /// How fast the point mass turns its body to face its direction of travel.
+    pub turn_rate_deg_per_s: f32,
     /// Touchdown to touchdown.
     pub hop_period_s: f32,
     /// Part of the hop cycle spent in the air, after stance (0..1).
@@ -154,6 +156,7 @@ impl Validate for CreatureDef {
         });
         v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
         v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
+        v.positive("turn_rate_deg_per_s", self.turn_rate_deg_per_s);
         v.positive("hop_period_s", self.hop_period_s);
         v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
         v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);

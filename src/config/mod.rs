@@ -7,12 +7,14 @@
 mod arena;
 mod creature;
 mod loader;
+mod rules;
 mod scenario;
 mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
 pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConfig, SteeringConfig};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
+pub use rules::{CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};
 
@@ -30,6 +32,7 @@ pub struct SimConfig {
     pub kinds: Vec<CreatureDef>,
     /// Each kind's gait table, if it has one (same index as `kinds`).
     pub gaits: Vec<Option<GaitTable>>,
+    pub rules: LevelRules,
 }
 
 impl SimConfig {
@@ -71,11 +74,13 @@ impl SimConfig {
             .iter()
             .map(|k| load_gait(assets_root, k))
             .collect::<Result<_, _>>()?;
+        let rules: LevelRules = load_file(&assets_root.join(&scenario.level_rules))?;
         let config = Self {
             scenario,
             arena,
             kinds,
             gaits,
+            rules,
         };
         config.check_fit(scenario_path)?;
         Ok(config)
@@ -150,6 +155,8 @@ pub fn plugin(app: &mut App) {
         app.init_asset::<Scenario>()
             .init_asset::<ArenaConfig>()
             .init_asset::<CreatureDef>()
+            .init_asset::<LevelRules>()
+            .init_asset_loader::<RonAssetLoader<LevelRules>>()
             .init_asset_loader::<RonAssetLoader<Scenario>>()
             .init_asset_loader::<RonAssetLoader<ArenaConfig>>()
             .init_asset_loader::<RonAssetLoader<CreatureDef>>();

@@ -20,6 +20,9 @@ pub struct Scenario {
     pub arena: String,
     pub creatures: Vec<CreatureGroup>,
     pub level_policy: LevelPolicy,
+    /// The level rules file (relative to the assets folder): influence areas, camera rule,
+    /// switching window.
+    pub level_rules: String,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

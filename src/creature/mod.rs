@@ -9,13 +9,13 @@ use std::ops::Index;
 use crate::WorldRng;
 use crate::config::{CreatureDef, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable};
-use crate::lod::Lod;
+use crate::lod::{LevelChoice, Lod};
 use crate::outcome::CollisionRecord;
 use std::collections::HashMap;
 
 /// A legged creature. Its level of detail is the [`Lod`] component beside it.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
-#[require(Lod, PlanarState, GaitPhase, GaitPose, DesiredVelocity, CollisionRecord)]
+#[require(Lod, LevelChoice, PlanarState, GaitPhase, GaitPose, DesiredVelocity, CollisionRecord)]
 pub struct Creature {
     /// Index into [`KindTable`] (and [`SimConfig::kinds`]).
     pub kind: usize,
@@ -77,6 +77,7 @@ pub struct KindParams {
     pub acceleration_limit_m_per_s2: f32,
     /// How fast the rigid model's command follows the desired velocity.
     pub command_acceleration_m_per_s2: f32,
+    pub turn_rate_rad_per_s: f32,
     /// Standing pose: the point-mass level holds it (the leg straight down).
     pub standing_pose: GaitPose,
     /// Hop cycles per second.
@@ -88,19 +89,19 @@ pub struct KindParams {
     pub steering: SteeringConfig,
     pub rigid: Option<RigidConfig>,
     pub gait: Option<GaitTable>,
+    /// The levels this kind has a model for, cheapest first.
+    pub levels: Vec<Lod>,
 }
 
 impl KindParams {
-    /// The levels this kind has a model for.
-    pub fn levels(&self) -> Vec<Lod> {
-        Lod::ALL
-            .into_iter()
-            .filter(|l| match l {
-                Lod::PointMass => true,
-                Lod::Hybrid => self.gait.is_some(),
-                Lod::Rigid => self.rigid.is_some(),
-            })
-            .collect()
+    /// The most detailed level this kind has a model for, at or below `wanted`.
+    pub fn best_level(&self, wanted: Lod) -> Lod {
+        self.levels
+            .iter()
+            .copied()
+            .filter(|&l| l <= wanted)
+            .max()
+            .unwrap_or(Lod::PointMass)
     }
 
     pub fn new(d: &CreatureDef, gait: Option<&GaitTable>) -> Self {
@@ -110,6 +111,7 @@ impl KindParams {
             top_speed_m_per_s: gait.map_or(d.top_speed_m_per_s, |g| g.top_speed_m_per_s),
             acceleration_limit_m_per_s2: gait.map_or(d.acceleration_limit_m_per_s2, |g| g.acceleration_limit_m_per_s2),
             command_acceleration_m_per_s2: d.acceleration_limit_m_per_s2,
+            turn_rate_rad_per_s: d.turn_rate_deg_per_s.to_radians(),
             standing_pose: GaitPose {
                 body_height_m: d.body.hip_height_m,
                 leg_length_m: d.body.hip_height_m,
@@ -122,6 +124,14 @@ impl KindParams {
             steering: d.steering.clone(),
             rigid: d.rigid.clone(),
             gait: gait.cloned(),
+            levels: Lod::ALL
+                .into_iter()
+                .filter(|l| match l {
+                    Lod::PointMass => true,
+                    Lod::Hybrid => gait.is_some(),
+                    Lod::Rigid => d.rigid.is_some(),
+                })
+                .collect(),
         }
     }
 }
@@ -257,7 +267,7 @@ fn spawn_creatures(
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
-        let level = config.scenario.level_policy.initial_level(kinds[kind].levels());
+        let level = config.scenario.level_policy.initial_level(&kinds[kind].levels);
         for _ in 0..group.count {
             // The puck starts at the centre.
             let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {

@@ -4,6 +4,12 @@
 //! Only levels with a working model behind them exist: the point mass (section 3.3), the
 //! hybrid (3.2) and the rigid body (3.1).
 
+mod select;
+mod switch;
+
+pub use select::{LevelChoice, SimCamera, in_influence};
+pub use switch::{LevelSwitched, SwitchTally};
+
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -51,23 +57,46 @@ pub enum LevelPolicy {
     AllHybrid,
     /// Every creature at the rigid level.
     AllRigid,
+    /// Areas of influence (figure 5): rigid inside another's area, else hybrid.
+    Influence,
+    /// The camera rule (figure 6): rigid in view and near, hybrid in view, else point mass.
+    Camera,
+    /// The more detailed of the two.
+    Combined,
 }
 
 impl LevelPolicy {
+    /// Whether levels change during a game under this policy.
+    pub fn is_dynamic(self) -> bool {
+        matches!(
+            self,
+            LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined
+        )
+    }
+
     /// The level a creature starts at, given the levels its kind has models for: the policy's
-    /// level, or the most detailed one below it that the kind has.
-    pub fn initial_level(self, available: Vec<Lod>) -> Lod {
+    /// level (hybrid for the rules, which then move it), or the most detailed one below it
+    /// that the kind has.
+    pub fn initial_level(self, available: &[Lod]) -> Lod {
         let wanted = match self {
             LevelPolicy::AllPointMass => Lod::PointMass,
-            LevelPolicy::AllHybrid => Lod::Hybrid,
+            LevelPolicy::AllHybrid | LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined => {
+                Lod::Hybrid
+            }
             LevelPolicy::AllRigid => Lod::Rigid,
         };
         available
-            .into_iter()
+            .iter()
+            .copied()
             .filter(|&l| l <= wanted)
             .max()
             .unwrap_or(Lod::PointMass)
     }
+}
+
+pub(super) fn plugin(app: &mut App) {
+    select::plugin(app);
+    switch::plugin(app);
 }
 
 #[cfg(test)]
@@ -77,17 +106,11 @@ mod tests {
     #[test]
     fn a_kind_without_the_wanted_model_gets_the_most_detailed_level_below_it() {
         assert_eq!(
-            LevelPolicy::AllRigid.initial_level(vec![Lod::PointMass, Lod::Hybrid]),
+            LevelPolicy::AllRigid.initial_level(&[Lod::PointMass, Lod::Hybrid]),
             Lod::Hybrid
         );
-        assert_eq!(
-            LevelPolicy::AllRigid.initial_level(vec![Lod::PointMass]),
-            Lod::PointMass
-        );
-        assert_eq!(LevelPolicy::AllHybrid.initial_level(Lod::ALL.to_vec()), Lod::Hybrid);
-        assert_eq!(
-            LevelPolicy::AllPointMass.initial_level(Lod::ALL.to_vec()),
-            Lod::PointMass
-        );
+        assert_eq!(LevelPolicy::AllRigid.initial_level(&[Lod::PointMass]), Lod::PointMass);
+        assert_eq!(LevelPolicy::AllHybrid.initial_level(&Lod::ALL), Lod::Hybrid);
+        assert_eq!(LevelPolicy::AllPointMass.initial_level(&Lod::ALL), Lod::PointMass);
     }
 }

@@ -23,7 +23,15 @@ pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt
     state.position += state.velocity * dt;
     let speed = state.velocity.length();
     if speed > HEADING_MIN_SPEED_M_PER_S {
-        state.heading = state.velocity / speed;
+        // Turn toward the direction of travel at the turn rate: no pop when the body came
+        // from a level that faced elsewhere.
+        let travel = state.velocity / speed;
+        let max_turn = kind.turn_rate_rad_per_s * dt;
+        state.heading = if state.heading.dot(travel) >= max_turn.cos() {
+            travel
+        } else {
+            Vec2::from_angle(max_turn.copysign(state.heading.perp_dot(travel))).rotate(state.heading)
+        };
     }
 }
 
@@ -98,6 +106,7 @@ mod tests {
             fall_impact_speed_m_per_s: 2.0,
             collision_restitution: 0.0,
             command_acceleration_m_per_s2: 2.0,
+            turn_rate_rad_per_s: 1000.0,
             standing_pose: GaitPose::default(),
             steering: SteeringConfig {
                 cruise_speed_m_per_s: 1.0,
@@ -112,6 +121,7 @@ mod tests {
             },
             rigid: None,
             gait: None,
+            levels: vec![Lod::PointMass],
         }
     }
 

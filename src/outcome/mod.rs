@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
 use crate::creature::{Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot};
-use crate::lod::Lod;
+use crate::lod::{Lod, SwitchTally};
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, WorldRng};
 
@@ -268,6 +268,11 @@ pub struct Summary {
     pub respawns: u64,
     /// Creatures at each level at the end.
     pub levels: BTreeMap<&'static str, u64>,
+    /// Level switches: `total`, and by direction (`"hybrid->rigid"`, ...).
+    pub switches: BTreeMap<String, u64>,
+    /// Creatures at each level, averaged over the run's steering decisions, and the peak.
+    pub levels_mean: BTreeMap<&'static str, f64>,
+    pub levels_peak: BTreeMap<&'static str, u64>,
     pub sim_seconds: f64,
     /// Wall-clock seconds; the only field that differs between identical runs.
     pub wall_seconds: f64,
@@ -293,7 +298,27 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         collided += u64::from(record.hit_puck_or_wall());
     }
     let sim_seconds = clock.seconds();
+    let switching = world.resource::<SwitchTally>().clone();
+    let mut switches: BTreeMap<String, u64> = BTreeMap::from([("total".to_owned(), switching.total())]);
+    for from in Lod::ALL {
+        for to in Lod::ALL {
+            let n = switching.switches[from as usize][to as usize];
+            if n > 0 {
+                switches.insert(format!("{}->{}", from.name(), to.name()), n);
+            }
+        }
+    }
+    let samples = switching.samples.max(1) as f64;
     Summary {
+        switches,
+        levels_mean: Lod::ALL
+            .iter()
+            .map(|&l| (l.name(), switching.level_sums[l as usize] as f64 / samples))
+            .collect(),
+        levels_peak: Lod::ALL
+            .iter()
+            .map(|&l| (l.name(), switching.level_peaks[l as usize]))
+            .collect(),
         seed,
         creatures,
         collisions: Obstacle::ALL

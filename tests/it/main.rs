@@ -10,3 +10,4 @@ mod outcome;
 mod rigid;
 mod steering;
 mod support;
+mod switching;

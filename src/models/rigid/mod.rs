@@ -70,22 +70,18 @@ fn part(creature: Entity, transform: Transform, velocity: Vec3) -> impl Bundle {
     )
 }
 
-/// Builds the bodies of a creature at the rigid level: standing on a vertical leg at rest
-/// length with the foot just above the ground, moving at the creature's planar velocity and
-/// facing its heading.
+/// Builds the bodies of a creature at the rigid level: the hip at `hip_height_m` above its
+/// planar position, the leg hanging straight down at rest length, facing its heading.
 pub fn spawn_hopper(
     commands: &mut Commands,
     creature: Entity,
     r: &RigidConfig,
     mass_kg: f32,
     state: &PlanarState,
+    hip_height_m: f32,
 ) -> RigidHopper {
     let yaw = Quat::from_rotation_y(-state.heading.y.atan2(state.heading.x));
-    let hip = Vec3::new(
-        state.position.x,
-        r.leg_rest_length_m + r.foot_radius_m + 0.02,
-        state.position.y,
-    );
+    let hip = Vec3::new(state.position.x, hip_height_m, state.position.y);
     let velocity = Vec3::new(state.velocity.x, 0.0, state.velocity.y);
     let (hx, hy, hz) = r.body_half_extents_m;
     let body = commands
@@ -167,18 +163,45 @@ fn build_bodies(
     mut commands: Commands,
     kinds: Res<KindTable>,
     clock: Res<SimClock>,
-    creatures: Query<(Entity, &Creature, &Lod, &PlanarState), Without<RigidHopper>>,
+    creatures: Query<
+        (Entity, &Creature, &Lod, &PlanarState, &GaitPhase, &GaitPose),
+        (Without<RigidHopper>, Changed<Lod>),
+    >,
 ) {
-    for (entity, creature, lod, state) in &creatures {
+    let now = clock.seconds() as f32;
+    for (entity, creature, lod, state, gait, pose) in &creatures {
         let kind = &kinds[creature.kind];
         let (Lod::Rigid, Some(r)) = (lod, &kind.rigid) else {
             continue;
         };
-        let hopper = spawn_hopper(&mut commands, entity, r, kind.mass_kg, state);
-        commands.entity(entity).insert((
-            hopper,
-            Raibert::new(r, kind.mass_kg, state.velocity, clock.seconds() as f32),
-        ));
+        // The body at the height the lower level had it, the leg hanging at rest length
+        // clear of the ground; the hop resumes where it was.
+        let hip = pose.body_height_m.max(r.leg_rest_length_m + r.foot_radius_m + 0.005);
+        let hopper = spawn_hopper(&mut commands, entity, r, kind.mass_kg, state, hip);
+        let mut raibert = Raibert::new(r, kind.mass_kg, state.velocity, now);
+        raibert.last_touchdown_s = now - gait.cycle * raibert.hop_period_s;
+        raibert.last_liftoff_s = (raibert.last_touchdown_s + raibert.stance_s).min(now);
+        commands.entity(entity).insert((hopper, raibert));
+    }
+}
+
+/// Rapier builds a new multibody at rest whatever velocities its bodies were given: set the
+/// free root's velocity, which carries the whole tree, from the planar state.
+fn carry_velocity_into_bodies(
+    mut context: Query<&mut RapierContextJoints>,
+    new: Query<(&PlanarState, &RigidHopper), Added<RigidHopper>>,
+    handles: Query<&RapierMultibodyJointHandle>,
+) {
+    let Ok(mut joints) = context.single_mut() else { return };
+    for (state, hopper) in &new {
+        let Ok(handle) = handles.get(hopper.upper_leg) else {
+            continue;
+        };
+        if let Some((multibody, _)) = joints.multibody_joints.get_mut(handle.0) {
+            let mut velocity = multibody.generalized_velocity_mut();
+            velocity[0] = state.velocity.x;
+            velocity[2] = state.velocity.y;
+        }
     }
 }
 
@@ -262,6 +285,12 @@ pub(super) fn plugin(app: &mut App) {
             (build_bodies, controller::control_hoppers)
                 .chain()
                 .in_set(SimStage::Step),
+        )
+        .add_systems(
+            FixedUpdate,
+            carry_velocity_into_bodies
+                .after(PhysicsSet::SyncBackend)
+                .before(PhysicsSet::StepSimulation),
         )
         .add_systems(FixedUpdate, observe_hoppers.in_set(SimStage::Observe));
 }

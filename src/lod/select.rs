@@ -1,0 +1,251 @@
+//! SelectLod: the level each creature should be at (paper 3.4).
+//!
+//! Areas of influence (figure 5): the puck and every creature have a circle of influence
+//! stretched in the direction of travel; a wall's area is every point within a band of it.
+//! A creature inside any area but its own should be rigid: "the areas of influence represent an
+//! approximate measure of the probability of a collision occurring within a short period of
+//! time". Otherwise hybrid.
+//!
+//! The stretched circle: for a body at `p` moving at `v`, with radius `r` and look-ahead `T`,
+//! the area is the ellipse centred at `p + v T / 2` with semi-axis `r + |v| T / 2` along `v`
+//! and `r` across it: it covers the circle around the body now and around where it will be
+//! `T` later.
+//!
+//! The camera rule (figure 6): out of the view cone, point mass; in view but further than the
+//! camera's radius, hybrid; in view and within it, rigid. The headless camera rides behind a
+//! creature (the player's, else the lowest serial) looking at the puck, as in figure 9.
+//!
+//! Hysteresis: entering an area uses its radius; leaving it takes `release_margin_m` more,
+//! and a creature keeps a new level at least `min_dwell_s`.
+
+use bevy::prelude::*;
+
+use super::{LevelPolicy, Lod};
+use crate::arena::{Court, PuckState};
+use crate::config::{LevelRules, SimConfig};
+use crate::creature::{Creature, KindTable, PlanarState, PlayerControlled};
+use crate::sense::NeighbourGrid;
+use crate::{SimClock, SimStage};
+
+/// The level the rules want for a creature, and when it last switched.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct LevelChoice {
+    pub wanted: Lod,
+    /// Simulated time of the last switch (for `min_dwell_s`).
+    pub last_switch_s: f32,
+}
+
+/// The headless camera of the camera rule, on the ground plane.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct SimCamera {
+    pub position: Vec2,
+    /// Unit view direction.
+    pub facing: Vec2,
+    /// The creature it follows.
+    pub following: Option<Entity>,
+}
+
+/// Whether `q` lies in the stretched circle of a body at `p` moving at `v`.
+pub fn in_influence(q: Vec2, p: Vec2, v: Vec2, radius: f32, lookahead_s: f32) -> bool {
+    let reach = v * (lookahead_s / 2.0);
+    let d = q - (p + reach);
+    let Some(along) = v.try_normalize() else {
+        return d.length_squared() <= radius * radius;
+    };
+    let a = radius + reach.length();
+    let (x, y) = (d.dot(along) / a, d.perp_dot(along) / radius.max(1e-6));
+    x * x + y * y <= 1.0
+}
+
+/// Radii grown by `grow` metres (the hysteresis margin when deciding whether to stay).
+struct Radii {
+    puck: f32,
+    creature: f32,
+    wall: f32,
+    camera: f32,
+}
+
+impl Radii {
+    fn of(rules: &LevelRules, grow: f32) -> Self {
+        Self {
+            puck: rules.influence.puck_radius_m + grow,
+            creature: rules.influence.creature_radius_m + grow,
+            wall: rules.influence.wall_band_m + grow,
+            camera: rules.camera.radius_m + grow,
+        }
+    }
+}
+
+struct LevelInputs<'a> {
+    rules: &'a LevelRules,
+    puck: &'a PuckState,
+    court: &'a Court,
+    grid: &'a NeighbourGrid,
+    camera: &'a SimCamera,
+    reach_m: f32,
+    half_fov_cos: f32,
+}
+
+impl LevelInputs<'_> {
+    fn influence_level(&self, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
+        let la = self.rules.influence.lookahead_s;
+        let near_wall = (self.court.half_extents - s.position.abs()).min_element() <= r.wall;
+        let in_puck = in_influence(
+            s.position,
+            self.puck.position,
+            self.puck.velocity,
+            r.puck + self.puck.radius_m,
+            la,
+        );
+        let mut in_creature = false;
+        if !(near_wall || in_puck) {
+            self.grid.for_each_within(s.position, self.reach_m + r.creature, |n| {
+                in_creature |= n.serial != c.serial && in_influence(s.position, n.position, n.velocity, r.creature, la);
+            });
+        }
+        if near_wall || in_puck || in_creature {
+            Lod::Rigid
+        } else {
+            Lod::Hybrid
+        }
+    }
+
+    fn camera_level(&self, s: &PlanarState, r: &Radii) -> Lod {
+        let to = s.position - self.camera.position;
+        let distance = to.length();
+        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.half_fov_cos;
+        match (in_view, distance <= r.camera) {
+            (false, _) => Lod::PointMass,
+            (true, false) => Lod::Hybrid,
+            (true, true) => Lod::Rigid,
+        }
+    }
+
+    fn level(&self, policy: LevelPolicy, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
+        match policy {
+            LevelPolicy::Influence => self.influence_level(c, s, r),
+            LevelPolicy::Camera => self.camera_level(s, r),
+            LevelPolicy::Combined => self.influence_level(c, s, r).max(self.camera_level(s, r)),
+            fixed => fixed.initial_level(&Lod::ALL),
+        }
+    }
+}
+
+/// Moves the headless camera behind the creature it follows, facing the puck.
+fn place_camera(
+    config: Res<SimConfig>,
+    puck: Res<PuckState>,
+    mut camera: ResMut<SimCamera>,
+    player: Query<(Entity, &PlanarState), With<PlayerControlled>>,
+    creatures: Query<(Entity, &Creature, &PlanarState)>,
+) {
+    let followed = match camera.following.and_then(|e| creatures.get(e).ok()) {
+        Some((e, _, s)) if player.is_empty() || player.contains(e) => Some((e, *s)),
+        _ => player.iter().next().map(|(e, s)| (e, *s)).or_else(|| {
+            creatures
+                .iter()
+                .min_by_key(|(_, c, _)| c.serial)
+                .map(|(e, _, s)| (e, *s))
+        }),
+    };
+    let Some((entity, state)) = followed else { return };
+    let facing = (puck.position - state.position)
+        .try_normalize()
+        .unwrap_or(state.heading);
+    *camera = SimCamera {
+        position: state.position - facing * config.rules.camera.follow_distance_m,
+        facing,
+        following: Some(entity),
+    };
+}
+
+/// At each decision, the level the policy wants for every creature, with hysteresis.
+fn select_levels(
+    clock: Res<SimClock>,
+    config: Res<SimConfig>,
+    kinds: Res<KindTable>,
+    puck: Res<PuckState>,
+    court: Res<Court>,
+    grid: Res<NeighbourGrid>,
+    camera: Res<SimCamera>,
+    mut creatures: Query<(&Creature, &Lod, &PlanarState, &mut LevelChoice)>,
+) {
+    if !clock.is_decision_tick() {
+        return;
+    }
+    let rules = &config.rules;
+    let policy = config.scenario.level_policy;
+    let top_speed = kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
+    let inputs = LevelInputs {
+        rules,
+        puck: &puck,
+        court: &court,
+        grid: &grid,
+        camera: &camera,
+        reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
+        half_fov_cos: (rules.camera.field_of_view_deg.to_radians() / 2.0).cos(),
+    };
+    let (enter, leave) = (Radii::of(rules, 0.0), Radii::of(rules, rules.release_margin_m));
+    let now = clock.seconds() as f32;
+    for_each_creature!(config.scenario.creature_count(), creatures, |(
+        c,
+        lod,
+        s,
+        mut choice,
+    ): (
+        &Creature,
+        &Lod,
+        &PlanarState,
+        Mut<LevelChoice>
+    )| {
+        let kind = &kinds[c.kind];
+        let up = kind.best_level(inputs.level(policy, c, s, &enter));
+        let down = kind.best_level(inputs.level(policy, c, s, &leave));
+        let dwelling = now - choice.last_switch_s < rules.min_dwell_s;
+        let wanted = if up > *lod {
+            up
+        } else if down < *lod && !dwelling {
+            down
+        } else {
+            *lod
+        };
+        if choice.wanted != wanted {
+            choice.wanted = wanted;
+        }
+    });
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<SimCamera>().add_systems(
+        FixedUpdate,
+        (place_camera, select_levels)
+            .chain()
+            .in_set(SimStage::SelectLod)
+            .run_if(dynamic_policy),
+    );
+}
+
+/// Whether the scenario's policy changes levels during the game.
+pub fn dynamic_policy(config: Res<SimConfig>) -> bool {
+    config.scenario.level_policy.is_dynamic()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_area_of_influence_stretches_ahead_of_a_moving_body() {
+        let (p, v) = (Vec2::ZERO, Vec2::new(4.0, 0.0));
+        // Radius 2, 1 s ahead: reaches from x = -2 to x = 2 + 4 = 6, and 2 across.
+        assert!(in_influence(Vec2::new(5.9, 0.0), p, v, 2.0, 1.0));
+        assert!(!in_influence(Vec2::new(6.1, 0.0), p, v, 2.0, 1.0));
+        assert!(in_influence(Vec2::new(-1.9, 0.0), p, v, 2.0, 1.0));
+        assert!(!in_influence(Vec2::new(-2.1, 0.0), p, v, 2.0, 1.0));
+        assert!(in_influence(Vec2::new(2.0, 1.9), p, v, 2.0, 1.0));
+        assert!(!in_influence(Vec2::new(2.0, 2.1), p, v, 2.0, 1.0));
+        // At rest it is a plain circle.
+        assert!(in_influence(Vec2::new(0.0, 1.9), p, Vec2::ZERO, 2.0, 1.0));
+        assert!(!in_influence(Vec2::new(2.1, 0.0), p, Vec2::ZERO, 2.0, 1.0));
+    }
+}
