@@ -180,4 +180,34 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
             }
         }
     }
+    game_speedup(config, warmup, frames, json);
+}
+
+/// The scenario's own game under the influence policy against the identical game all rigid
+/// (the saving the paper's figure 8 measures).
+fn game_speedup(config: &SimConfig, warmup: usize, frames: usize, json: bool) {
+    let frame_ms = |policy: LevelPolicy| {
+        let mut c = config.clone();
+        c.scenario.level_policy = policy;
+        median_frame_seconds(c, warmup, frames) * 1e3
+    };
+    let (influence, rigid) = (frame_ms(LevelPolicy::Influence), frame_ms(LevelPolicy::AllRigid));
+    let creatures = config.scenario.creature_count();
+    if json {
+        for (policy, ms) in [("influence", influence), ("all_rigid", rigid)] {
+            println!(
+                "{}",
+                serde_json::json!({ "game": creatures, "policy": policy, "frame_ms_median": ms })
+            );
+        }
+        println!(
+            "{}",
+            serde_json::json!({ "game": creatures, "speedup": "all_rigid/influence", "ratio": rigid / influence })
+        );
+    } else {
+        println!(
+            "the scenario's game ({creatures} creatures): {influence:.2} ms a frame under the influence policy, {rigid:.2} ms all rigid: {:.1} times faster",
+            rigid / influence
+        );
+    }
 }
