@@ -6,12 +6,14 @@
 
 mod arena;
 mod creature;
+mod game;
 mod loader;
 mod scenario;
 mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
 pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConfig, SteeringConfig};
+pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};
@@ -39,28 +41,43 @@ impl SimConfig {
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
-        let mut kinds = Vec::with_capacity(scenario.creatures.len());
-        for (i, group) in scenario.creatures.iter().enumerate() {
-            if kinds.iter().any(|k: &CreatureDef| k.name == group.kind) {
-                continue;
-            }
-            let path = creature_file(assets_root, &group.kind);
+        Self::assemble(scenario_path, assets_root, scenario, arena, |i, kind| {
+            let path = creature_file(assets_root, kind);
             if !path.is_file() {
                 return Err(ConfigError::one(
                     scenario_path,
                     format!("creatures[{i}].kind"),
                     format!(
-                        "unknown creature kind {:?}: there is no {}; known kinds: {}",
-                        group.kind,
+                        "unknown creature kind {kind:?}: there is no {}; known kinds: {}",
                         path.display(),
                         known_kinds(assets_root).join(", ")
                     ),
                 ));
             }
-            let def: CreatureDef = load_file(&path)?;
+            load_file(&path)
+        })
+    }
+
+    /// Puts a scenario together with its arena and the creature kinds it names, and checks
+    /// what spans files. `kind_def(i, k)` gives the definition of kind `k`, first named by
+    /// creature group `i`: read from disk by [`SimConfig::load`], taken from the asset
+    /// server by the game, so both check the same things.
+    pub fn assemble(
+        scenario_path: &Path,
+        assets_root: &Path,
+        scenario: Scenario,
+        arena: ArenaConfig,
+        mut kind_def: impl FnMut(usize, &str) -> Result<CreatureDef, ConfigError>,
+    ) -> Result<Self, ConfigError> {
+        let mut kinds = Vec::with_capacity(scenario.creatures.len());
+        for (i, group) in scenario.creatures.iter().enumerate() {
+            if kinds.iter().any(|k: &CreatureDef| k.name == group.kind) {
+                continue;
+            }
+            let def = kind_def(i, &group.kind)?;
             if def.name != group.kind {
                 return Err(ConfigError::one(
-                    &path,
+                    &creature_file(assets_root, &group.kind),
                     "name",
                     format!("is {:?} but the file is named for kind {:?}", def.name, group.kind),
                 ));
@@ -145,13 +162,15 @@ fn known_kinds(assets_root: &Path) -> Vec<String> {
 /// Registers the asset types and their loader with Bevy's asset server, when it is present.
 pub fn plugin(app: &mut App) {
     if app.is_plugin_added::<bevy::asset::AssetPlugin>() {
-        // All three share the `.ron` extension: the asset server picks the loader by the
+        // All share the `.ron` extension: the asset server picks the loader by the
         // asset type asked for.
         app.init_asset::<Scenario>()
             .init_asset::<ArenaConfig>()
             .init_asset::<CreatureDef>()
+            .init_asset::<GameConfig>()
             .init_asset_loader::<RonAssetLoader<Scenario>>()
             .init_asset_loader::<RonAssetLoader<ArenaConfig>>()
-            .init_asset_loader::<RonAssetLoader<CreatureDef>>();
+            .init_asset_loader::<RonAssetLoader<CreatureDef>>()
+            .init_asset_loader::<RonAssetLoader<GameConfig>>();
     }
 }

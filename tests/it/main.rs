@@ -6,7 +6,10 @@ mod court;
 mod determinism;
 mod experiments;
 mod gait;
+#[cfg(feature = "game")]
+mod game;
 mod outcome;
+mod player;
 mod rigid;
 mod steering;
 mod support;
