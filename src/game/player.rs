@@ -66,26 +66,31 @@ fn steer_player(
     }
 }
 
-/// Keeps the score, and ends the round when the player's creature is gone (it fell).
+/// Keeps the score each tick, after collisions are noted and before the fallen are
+/// removed: the collision that knocks the player down counts.
 fn keep_score(
     clock: Res<SimClock>,
     mut round: ResMut<Round>,
     players: Query<&CollisionRecord, With<PlayerControlled>>,
 ) {
-    let Some(player) = round.player else {
-        return;
-    };
     if round.over {
         return;
     }
-    match players.get(player) {
-        Ok(record) => {
-            round.score = Some(Score {
-                survived_s: clock.seconds(),
-                collisions: record.count.iter().sum(),
-            });
-        }
-        Err(_) => round.over = true,
+    if let Some(record) = round.player.and_then(|p| players.get(p).ok()) {
+        round.score = Some(Score {
+            survived_s: clock.seconds(),
+            collisions: record.count.iter().sum(),
+        });
+    }
+}
+
+/// The round is over when the player's creature is gone: it fell and the core removed it.
+fn notice_fall(mut round: ResMut<Round>, players: Query<(), With<PlayerControlled>>) {
+    if let Some(player) = round.player
+        && !round.over
+        && players.get(player).is_err()
+    {
+        round.over = true;
     }
 }
 
@@ -117,5 +122,9 @@ pub fn plugin(app: &mut App) {
         .init_resource::<Round>()
         .init_resource::<PlayerIntent>()
         .add_systems(FixedUpdate, steer_player.in_set(SimStage::Steer))
-        .add_systems(Update, (start_rounds, choose_player, keep_score).chain());
+        .add_systems(
+            FixedUpdate,
+            keep_score.after(SimStage::Observe).before(SimStage::Outcome),
+        )
+        .add_systems(Update, (start_rounds, choose_player, notice_fall).chain());
 }
