@@ -49,6 +49,11 @@ pub struct InsetConfig {
     pub margin_px: f32,
     /// Ground shown around the court.
     pub border_m: f32,
+    /// Creatures are tiny seen from above: each gets a dot this big, seen only from above.
+    pub creature_dot_radius_m: f32,
+    /// The player's view, drawn from above as a fan (paper figure 6, top).
+    pub view_cone_length_m: f32,
+    pub view_cone_opacity: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -96,6 +101,10 @@ pub struct HudConfig {
 pub struct CreatureLook {
     /// Body radius as a share of the creature's footprint radius (`body.radius_m`).
     pub body_radius_fraction: f32,
+    /// The body is an ellipsoid: its length (along the heading) and height as shares of
+    /// its width.
+    pub body_length_ratio: f32,
+    pub body_height_ratio: f32,
     pub leg_thickness_m: f32,
     /// The point-mass level holds the leg at this constant angle from the vertical, the foot
     /// forward (paper 3.3).
@@ -127,6 +136,9 @@ impl Validate for GameConfig {
             v.within("width_fraction", i.width_fraction, 0.05, 0.9);
             v.within("margin_px", i.margin_px, 0.0, 200.0);
             v.non_negative("border_m", i.border_m);
+            v.positive("creature_dot_radius_m", i.creature_dot_radius_m);
+            v.positive("view_cone_length_m", i.view_cone_length_m);
+            v.within("view_cone_opacity", i.view_cone_opacity, 0.0, 1.0);
         });
         v.nested("level_colours_srgb", |v| {
             for level in Lod::ALL {
@@ -168,6 +180,8 @@ impl Validate for GameConfig {
         let k = &self.creature_look;
         v.nested("creature_look", |v| {
             v.within("body_radius_fraction", k.body_radius_fraction, 0.1, 3.0);
+            v.within("body_length_ratio", k.body_length_ratio, 0.2, 5.0);
+            v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
             v.positive("leg_thickness_m", k.leg_thickness_m);
             v.within("point_mass_leg_angle_deg", k.point_mass_leg_angle_deg, -60.0, 60.0);
         });

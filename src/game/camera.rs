@@ -2,12 +2,15 @@
 //! creature from the side away from the puck so the puck stays in view; and an overhead
 //! view of the whole court, inset in a corner of the window.
 
+use bevy::camera::visibility::RenderLayers;
 use bevy::camera::{ScalingMode, Viewport};
 use bevy::prelude::*;
 use bevy::window::PrimaryWindow;
 
 use super::GameSettings;
+use super::creatures::OVERHEAD_ONLY;
 use super::player::Round;
+use super::scene::srgb;
 use crate::arena::{Court, PuckState};
 use crate::creature::PlanarState;
 
@@ -23,6 +26,13 @@ struct OverheadCamera;
 #[derive(Component)]
 struct InsetFrame;
 
+/// The player's view seen from above: a fan from the follow camera, as wide as its view.
+#[derive(Component)]
+struct ViewCone {
+    /// Length and half angle of the fan its mesh was made for.
+    shape: (f32, f32),
+}
+
 /// Where the follow camera is headed: the eye and the point it looks at.
 #[derive(Resource, Default)]
 struct FollowTarget {
@@ -33,7 +43,7 @@ struct FollowTarget {
     placed: bool,
 }
 
-fn spawn_cameras(mut commands: Commands) {
+fn spawn_cameras(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
     commands.spawn((
         Name::new("follow camera"),
         FollowCamera,
@@ -49,6 +59,18 @@ fn spawn_cameras(mut commands: Commands) {
         Camera { order: 1, ..default() },
         Projection::from(OrthographicProjection::default_3d()),
         Transform::from_xyz(0.0, 60.0, 0.0).looking_at(Vec3::ZERO, Vec3::NEG_Z),
+        RenderLayers::from_layers(&[0, OVERHEAD_ONLY]),
+    ));
+    commands.spawn((
+        Name::new("view cone"),
+        ViewCone { shape: (0.0, 0.0) },
+        Mesh3d::default(),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            unlit: true,
+            alpha_mode: AlphaMode::Blend,
+            ..default()
+        })),
+        RenderLayers::layer(OVERHEAD_ONLY),
     ));
     commands.spawn((
         Name::new("overhead frame"),
@@ -134,8 +156,48 @@ fn place_overhead(
     frame.height = px(extent.y / scale + 2.0 * border);
 }
 
+/// Lays the fan on the ground under the follow camera, pointing where it looks.
+fn draw_view_cone(
+    settings: Res<GameSettings>,
+    window: Single<&Window, With<PrimaryWindow>>,
+    camera: Single<&Transform, With<FollowCamera>>,
+    mut cone: Single<
+        (
+            &mut ViewCone,
+            &mut Mesh3d,
+            &MeshMaterial3d<StandardMaterial>,
+            &mut Transform,
+        ),
+        Without<FollowCamera>,
+    >,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    let inset = &settings.inset;
+    let (cone, mesh, material, transform) = &mut *cone;
+    // The horizontal half angle of the view, from the vertical field of view and the window.
+    let aspect = window.width() / window.height().max(1.0);
+    let half = ((settings.camera.field_of_view_deg.to_radians() / 2.0).tan() * aspect).atan();
+    let shape = (inset.view_cone_length_m, half);
+    if cone.shape != shape {
+        cone.shape = shape;
+        // The sector points along +y in its plane; laid flat, along -z, the view's forward.
+        mesh.0 = meshes.add(
+            Mesh::from(CircularSector::new(shape.0, half))
+                .rotated_by(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        );
+    }
+    if settings.is_changed()
+        && let Some(mut m) = materials.get_mut(&material.0)
+    {
+        m.base_color = srgb(settings.scene_colours.player_marker_srgb).with_alpha(inset.view_cone_opacity);
+    }
+    let forward = camera.forward().as_vec3().with_y(0.0).normalize_or(Vec3::NEG_Z);
+    **transform = Transform::from_translation(camera.translation.with_y(0.04)).looking_to(forward, Vec3::Y);
+}
+
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<FollowTarget>()
         .add_systems(Startup, spawn_cameras)
-        .add_systems(Update, (follow_player, place_overhead));
+        .add_systems(Update, (follow_player, place_overhead, draw_view_cone).chain());
 }

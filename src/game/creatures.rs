@@ -7,6 +7,7 @@
 //! a constant angle; a rigid level would copy its rapier bodies, a hybrid level would look
 //! its pose up in the gait table. Then [`apply_poses`] moves the meshes, whatever the level.
 
+use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
 
 use super::GameSettings;
@@ -35,7 +36,12 @@ pub struct CreatureVisual {
     pub creature: Entity,
     body: Entity,
     legs: Vec<Entity>,
+    /// Its dot in the overhead view.
+    dot: Entity,
 }
+
+/// The render layer only the overhead view sees: dots and the view cone.
+pub const OVERHEAD_ONLY: usize = 1;
 
 /// Where a creature's parts are this frame, in world space.
 #[derive(Component, Debug, Default, Clone, PartialEq)]
@@ -56,11 +62,15 @@ struct PartMeshes {
     sphere: Handle<Mesh>,
     cylinder: Handle<Mesh>,
     ring: Handle<Mesh>,
+    disc: Handle<Mesh>,
 }
 
-/// The ring on the ground under the player's creature.
+/// A ring on the ground under the player's creature, this many footprint radii across: a
+/// small one for the player's view, a big one for the overhead view.
 #[derive(Component)]
-struct PlayerMarker;
+struct PlayerMarker {
+    radii: f32,
+}
 
 fn spawn_visuals(
     mut commands: Commands,
@@ -80,6 +90,13 @@ fn spawn_visuals(
         let body = commands
             .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
             .id();
+        let dot = commands
+            .spawn((
+                Mesh3d(meshes.disc.clone()),
+                MeshMaterial3d(palette.body(*lod)),
+                RenderLayers::layer(OVERHEAD_ONLY),
+            ))
+            .id();
         let legs: Vec<Entity> = (0..leg_count)
             .map(|_| {
                 commands
@@ -95,12 +112,13 @@ fn spawn_visuals(
                 Visibility::default(),
                 CreaturePose::default(),
             ))
-            .add_children(&[body])
+            .add_children(&[body, dot])
             .add_children(&legs)
             .insert(CreatureVisual {
                 creature: entity,
                 body,
                 legs,
+                dot,
             });
     }
 }
@@ -174,17 +192,29 @@ fn apply_poses(
     mut roots: Query<(&CreatureVisual, &CreaturePose, &mut Transform)>,
     mut parts: Query<(&mut Transform, Option<&mut MeshMaterial3d<StandardMaterial>>), Without<CreatureVisual>>,
 ) {
-    let thickness = settings.creature_look.leg_thickness_m;
+    let look = &settings.creature_look;
+    let thickness = look.leg_thickness_m;
+    let body_shape = Vec3::new(1.0, look.body_height_ratio, look.body_length_ratio);
+    let dot_radius = settings.inset.creature_dot_radius_m;
     for (visual, pose, mut root) in &mut roots {
         *root = pose.body;
         let to_local = pose.body.to_matrix().inverse();
+        let level = palette.body(pose.level);
         if let Ok((mut body, material)) = parts.get_mut(visual.body) {
-            *body = Transform::from_scale(Vec3::splat(pose.body_radius_m));
-            if let Some(mut material) = material {
-                let wanted = palette.body(pose.level);
-                if material.0 != wanted {
-                    material.0 = wanted;
-                }
+            *body = Transform::from_scale(body_shape * pose.body_radius_m);
+            if let Some(mut material) = material
+                && material.0 != level
+            {
+                material.0 = level.clone();
+            }
+        }
+        if let Ok((mut dot, material)) = parts.get_mut(visual.dot) {
+            let ground = to_local.transform_point3(pose.body.translation.with_y(0.05));
+            *dot = Transform::from_translation(ground).with_scale(Vec3::splat(dot_radius));
+            if let Some(mut material) = material
+                && material.0 != level
+            {
+                material.0 = level;
             }
         }
         for (&leg, &(hip, foot)) in visual.legs.iter().zip(&pose.legs) {
@@ -204,28 +234,36 @@ fn mark_player(
     round: Res<Round>,
     kinds: Res<KindTable>,
     creatures: Query<(&Creature, &PlanarState)>,
-    mut marker: Query<(&mut Transform, &mut Visibility), With<PlayerMarker>>,
+    mut markers: Query<(&PlayerMarker, &mut Transform, &mut Visibility)>,
 ) {
-    let Ok((mut transform, mut visibility)) = marker.single_mut() else {
-        return;
-    };
-    match round.player.and_then(|p| creatures.get(p).ok()) {
-        Some((creature, state)) => {
-            let r = kinds[creature.kind].radius_m * 1.8;
-            *transform = Transform::from_xyz(state.position.x, 0.02, state.position.y).with_scale(Vec3::new(r, 1.0, r));
-            *visibility = Visibility::Inherited;
+    let player = round.player.and_then(|p| creatures.get(p).ok());
+    for (marker, mut transform, mut visibility) in &mut markers {
+        match player {
+            Some((creature, state)) => {
+                let r = kinds[creature.kind].radius_m * marker.radii;
+                *transform =
+                    Transform::from_xyz(state.position.x, 0.03, state.position.y).with_scale(Vec3::new(r, 1.0, r));
+                *visibility = Visibility::Inherited;
+            }
+            None => *visibility = Visibility::Hidden,
         }
-        None => *visibility = Visibility::Hidden,
     }
 }
 
-fn spawn_player_marker(mut commands: Commands, meshes: Res<PartMeshes>, palette: Res<Palette>) {
+fn spawn_player_markers(mut commands: Commands, meshes: Res<PartMeshes>, palette: Res<Palette>) {
+    let marker = |radii| {
+        (
+            PlayerMarker { radii },
+            Mesh3d(meshes.ring.clone()),
+            MeshMaterial3d(palette.player_marker.clone()),
+            Visibility::Hidden,
+        )
+    };
+    commands.spawn((Name::new("player marker"), marker(1.8)));
     commands.spawn((
-        Name::new("player marker"),
-        PlayerMarker,
-        Mesh3d(meshes.ring.clone()),
-        MeshMaterial3d(palette.player_marker.clone()),
-        Visibility::Hidden,
+        Name::new("player marker, overhead"),
+        marker(5.0),
+        RenderLayers::layer(OVERHEAD_ONLY),
     ));
 }
 
@@ -235,10 +273,12 @@ pub(super) fn plugin(app: &mut App) {
         sphere: assets.add(Sphere::new(1.0)),
         cylinder: assets.add(Cylinder::new(1.0, 1.0)),
         ring: assets.add(Torus::new(0.85, 1.0)),
+        // Flat on the ground, facing up.
+        disc: assets.add(Mesh::from(Circle::new(1.0)).rotated_by(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2))),
     };
     app.insert_resource(part_meshes)
         .configure_sets(Update, (DrawCreatures::Pose, DrawCreatures::Apply).chain())
-        .add_systems(Startup, spawn_player_marker)
+        .add_systems(Startup, spawn_player_markers)
         .add_systems(
             Update,
             (
