@@ -18,6 +18,9 @@ use crate::outcome::{Summary, summarize};
 #[derive(Resource, Debug, Default)]
 struct Timing {
     ticks_started: Option<Instant>,
+    /// When the last frame's ticks ended: the frame rate is measured by the wall clock, even
+    /// when `--screenshot` sets the game's time per frame.
+    last_frame: Option<Instant>,
     sim_ms_per_frame: f32,
     frames_per_s: f32,
 }
@@ -40,11 +43,15 @@ fn start_timing(mut timing: ResMut<Timing>) {
 
 /// Measured around the fixed loop, outside the simulation: the simulation never reads the
 /// clock.
-fn stop_timing(real: Res<Time<Real>>, settings: Res<GameSettings>, mut timing: ResMut<Timing>) {
+fn stop_timing(settings: Res<GameSettings>, mut timing: ResMut<Timing>) {
     let Some(start) = timing.ticks_started.take() else {
         return;
     };
-    let dt = real.delta_secs();
+    let now = Instant::now();
+    let dt = timing
+        .last_frame
+        .replace(now)
+        .map_or(0.0, |last| (now - last).as_secs_f32());
     let ease = 1.0 - (-dt / settings.hud.smoothing_s).exp();
     let sim_ms = start.elapsed().as_secs_f32() * 1000.0;
     timing.sim_ms_per_frame += (sim_ms - timing.sim_ms_per_frame) * ease;
@@ -144,7 +151,7 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
     );
     let _ = writeln!(
         s,
-        "{:.0} fps   simulation {:.2} ms/frame",
+        "{:.1} fps   simulation {:.2} ms/frame",
         timing.frames_per_s, timing.sim_ms_per_frame
     );
     let levels: Vec<String> = counts.levels.iter().map(|(l, n)| format!("{l} {n}")).collect();

@@ -38,6 +38,16 @@ impl Watched {
             changed: false,
         }
     }
+
+    /// Whether `id` is one of the files watched here. When a reload fails, the asset
+    /// server tries again with whichever loader owns the extension; that second attempt's
+    /// failure, under another asset type and id, is not ours to show.
+    fn watches(&self, id: UntypedAssetId) -> bool {
+        id == self.scenario.id().untyped()
+            || id == self.arena.id().untyped()
+            || id == self.game.id().untyped()
+            || self.kinds.values().any(|h| id == h.id().untyped())
+    }
 }
 
 /// What is wrong with the files now, by file: shown on screen until fixed.
@@ -72,8 +82,12 @@ fn failure_text(error: &AssetLoadError) -> String {
     }
 }
 
-fn note_failures<A: Asset>(mut failures: MessageReader<AssetLoadFailedEvent<A>>, mut problems: ResMut<Problems>) {
-    for failure in failures.read() {
+fn note_failures<A: Asset>(
+    mut failures: MessageReader<AssetLoadFailedEvent<A>>,
+    watched: Res<Watched>,
+    mut problems: ResMut<Problems>,
+) {
+    for failure in failures.read().filter(|f| watched.watches(f.id.untyped())) {
         problems
             .0
             .insert(failure.path.to_string(), failure_text(&failure.error));
@@ -89,7 +103,10 @@ fn note_changes<A: Asset>(
 ) {
     for event in events.read() {
         if let AssetEvent::Modified { id } | AssetEvent::LoadedWithDependencies { id } = event {
-            let id: UntypedAssetId = (*id).into();
+            let id = id.untyped();
+            if !watched.watches(id) {
+                continue;
+            }
             if let Some(path) = server.get_path(id) {
                 problems.0.remove(&path.to_string());
             }
