@@ -6,7 +6,7 @@
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy::time::TimeUpdateStrategy;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use crate::SimClock;
@@ -20,7 +20,7 @@ struct ScreenshotPlan {
 }
 
 /// A picture is blank when every pixel has nearly the same colour.
-pub fn is_blank(rgb: &[u8]) -> bool {
+fn is_blank(rgb: &[u8]) -> bool {
     let (mut lo, mut hi) = ([u8::MAX; 3], [0u8; 3]);
     for pixel in rgb.chunks_exact(3) {
         for c in 0..3 {
@@ -45,7 +45,7 @@ fn count_frames(mut commands: Commands, mut plan: ResMut<ScreenshotPlan>) {
 }
 
 /// Saves the picture unless it is blank; the exit status says which.
-fn save(image: &Image, path: &PathBuf) -> AppExit {
+fn save(image: &Image, path: &Path) -> AppExit {
     let rgb = match image.clone().try_into_dynamic() {
         Ok(picture) => picture.to_rgb8(),
         Err(e) => {
@@ -79,4 +79,18 @@ pub(super) fn plugin(app: &mut App, path: PathBuf, frames: u32) {
     })
     .insert_resource(TimeUpdateStrategy::ManualDuration(frame))
     .add_systems(Last, count_frames);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_blank;
+
+    #[test]
+    fn a_uniform_picture_is_blank_and_one_with_something_drawn_is_not() {
+        let sky = [140u8, 180, 215].repeat(1000);
+        assert!(is_blank(&sky));
+        let mut drawn = sky.clone();
+        drawn[1500..1503].copy_from_slice(&[20, 20, 20]);
+        assert!(!is_blank(&drawn));
+    }
 }
