@@ -53,7 +53,7 @@ fn read_game_keys(
     mut rounds: MessageWriter<NewRound>,
     mut exit: MessageWriter<AppExit>,
     mut colour_by_level: ResMut<ColourByLevel>,
-    mut config: ResMut<SimConfig>,
+    config: Res<SimConfig>,
     mut base: ResMut<BaseConfig>,
     mut notice: ResMut<Notice>,
 ) {
@@ -77,17 +77,14 @@ fn read_game_keys(
         ));
     }
     if keys.just_pressed(KeyCode::KeyL) {
-        // Every policy there is, in turn; a new policy applies at once and to later rounds.
+        // Every policy there is, in turn. A policy picks each creature's level when it
+        // spawns, so a new round starts with it (and later rounds keep it).
         let all = LevelPolicy::value_variants();
         let now = all.iter().position(|&p| p == config.scenario.level_policy).unwrap_or(0);
         let next = all[(now + 1) % all.len()];
-        config.scenario.level_policy = next;
         base.scenario.level_policy = next;
-        say(if all.len() == 1 {
-            format!("{} is the only level policy so far", policy_name(next))
-        } else {
-            format!("level policy: {}", policy_name(next))
-        });
+        rounds.write(NewRound);
+        say(format!("level policy {}: a new round", policy_name(next)));
     }
     let radius_keys = [
         KeyCode::BracketLeft,
@@ -97,9 +94,10 @@ fn read_game_keys(
     ];
     if keys.any_just_pressed(radius_keys) {
         // The puck's radius of influence (figure 8) and the camera's (figure 9) belong to
-        // the policies that switch creatures to the rigid level; these keys will change them.
+        // the policies that switch levels as creatures move (paper 3.4); these keys will
+        // change them.
         say(format!(
-            "the {} policy uses no radius of influence (they come with the rigid level)",
+            "the {} policy uses no radius of influence (they come with the switching rules)",
             policy_name(config.scenario.level_policy)
         ));
     }

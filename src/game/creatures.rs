@@ -17,6 +17,7 @@ use crate::SimEntity;
 use crate::config::SimConfig;
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::lod::Lod;
+use crate::models::rigid::{RigidHopper, RigidPart};
 
 /// Gravity for the drawn hop of a point mass, which has no vertical motion of its own.
 const GRAVITY_M_PER_S2: f32 = 9.81;
@@ -185,6 +186,34 @@ fn pose_point_masses(
     }
 }
 
+/// The rigid level (paper 3.1): the body and the leg where rapier has them.
+fn pose_rigid_hoppers(
+    kinds: Res<KindTable>,
+    settings: Res<GameSettings>,
+    creatures: Query<(&Creature, &Lod, &RigidHopper)>,
+    parts: Query<&Transform, With<RigidPart>>,
+    mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
+) {
+    // Rapier's body faces +x; a pose faces -z.
+    let to_pose = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
+    for (visual, mut pose) in &mut visuals {
+        let Ok((creature, &Lod::Rigid, hopper)) = creatures.get(visual.creature) else {
+            continue;
+        };
+        let (Ok(body), Ok(hip), Ok(foot)) = (
+            parts.get(hopper.body),
+            parts.get(hopper.upper_leg),
+            parts.get(hopper.lower_leg),
+        ) else {
+            continue;
+        };
+        pose.body = Transform::from_translation(body.translation).with_rotation(body.rotation * to_pose);
+        pose.body_radius_m = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
+        pose.legs = vec![(hip.translation, foot.translation)];
+        pose.level = Lod::Rigid;
+    }
+}
+
 /// Moves the meshes of every creature to its pose, and colours its body by its level.
 fn apply_poses(
     settings: Res<GameSettings>,
@@ -283,7 +312,7 @@ pub(super) fn plugin(app: &mut App) {
             Update,
             (
                 (despawn_orphans, spawn_visuals).chain().before(DrawCreatures::Pose),
-                pose_point_masses.in_set(DrawCreatures::Pose),
+                (pose_point_masses, pose_rigid_hoppers).in_set(DrawCreatures::Pose),
                 (apply_poses, mark_player).in_set(DrawCreatures::Apply),
             ),
         );
