@@ -10,6 +10,7 @@ mod gait;
 mod game;
 mod outcome;
 mod player;
+mod restart;
 mod rigid;
 mod steering;
 mod support;
