@@ -186,6 +186,9 @@ struct PlayArgs {
     /// The assets folder: the scenario's arena and creature kinds, and `game.ron`.
     #[arg(long, default_value = "assets")]
     assets: PathBuf,
+    /// Overrides the scenario's level policy (L switches it while playing).
+    #[arg(long, value_enum)]
+    policy: Option<LevelPolicy>,
     /// Render `--frames` frames, save the window to this PNG file and quit.
     #[arg(long, requires = "frames")]
     screenshot: Option<PathBuf>,
@@ -200,6 +203,7 @@ impl PlayArgs {
         simlod::game::play(simlod::game::PlayOptions {
             scenario: self.scenario,
             assets: self.assets,
+            policy: self.policy,
             screenshot: self.screenshot.zip(self.frames),
         })
     }

@@ -20,11 +20,14 @@ use std::path::{Path, PathBuf};
 
 use crate::SimPlugin;
 use crate::config::{GameConfig, SimConfig, load_file};
+use crate::lod::LevelPolicy;
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {
     pub scenario: PathBuf,
     pub assets: PathBuf,
+    /// Overrides the scenario's level policy.
+    pub policy: Option<LevelPolicy>,
     /// Render this many frames, save a screenshot here and quit.
     pub screenshot: Option<(PathBuf, u32)>,
 }
@@ -41,7 +44,10 @@ pub const NO_DISPLAY: &str = "simlod cannot open the game window: no display is 
 
 /// Opens the game window and plays until it closes.
 pub fn play(options: PlayOptions) -> Result<(), String> {
-    let config = SimConfig::load(&options.scenario, &options.assets).map_err(|e| e.to_string())?;
+    let mut config = SimConfig::load(&options.scenario, &options.assets).map_err(|e| e.to_string())?;
+    if let Some(policy) = options.policy {
+        config.scenario.level_policy = policy;
+    }
     let looks: GameConfig = load_file(&options.assets.join(GAME_FILE)).map_err(|e| e.to_string())?;
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
     let mut app = App::new();

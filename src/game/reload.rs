@@ -173,8 +173,10 @@ fn apply_changes(
     }
     match assemble(&mut watched, &server, &scenarios, &arenas, &kinds) {
         Ok(None) => return,
-        Ok(Some(config)) => {
+        Ok(Some(mut config)) => {
             problems.0.remove(ACROSS_FILES);
+            // The level policy is the player's (`--policy`, the L key), not the file's.
+            config.scenario.level_policy = base.scenario.level_policy;
             let same = config.scenario == base.scenario && config.arena == base.arena && config.kinds == base.kinds;
             if !same {
                 base.0 = config;

@@ -1,6 +1,5 @@
 //! Starting the world over (`simlod::start_over`): the game's new rounds and hot reload.
 
-use bevy::prelude::*;
 use bevy_rapier3d::prelude::RigidBody;
 
 use crate::support::*;
