@@ -106,9 +106,6 @@ pub struct CreatureLook {
     pub body_length_ratio: f32,
     pub body_height_ratio: f32,
     pub leg_thickness_m: f32,
-    /// The point-mass level holds the leg at this constant angle from the vertical, the foot
-    /// forward (paper 3.3).
-    pub point_mass_leg_angle_deg: f32,
     /// Kinds drawn with two legs (the biped); the others have one.
     pub two_legged_kinds: Vec<String>,
 }
@@ -183,7 +180,6 @@ impl Validate for GameConfig {
             v.within("body_length_ratio", k.body_length_ratio, 0.2, 5.0);
             v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
             v.positive("leg_thickness_m", k.leg_thickness_m);
-            v.within("point_mass_leg_angle_deg", k.point_mass_leg_angle_deg, -60.0, 60.0);
         });
     }
 }

@@ -3,9 +3,10 @@
 //! A simulated creature has no transform; each gets a drawing of its own: a root entity
 //! with a body and its legs as children. Drawing is two steps. First, the draw system of
 //! each level writes the [`CreaturePose`] of the creatures at that level from what that
-//! model knows: the point mass (here) from its planar state and hop phase, with the leg at
-//! a constant angle; a rigid level would copy its rapier bodies, a hybrid level would look
-//! its pose up in the gait table. Then [`apply_poses`] moves the meshes, whatever the level.
+//! model knows: the rigid level copies its rapier bodies; the hybrid and point-mass levels
+//! stand the body on the point mass in the [`GaitPose`] their model publishes (from the
+//! gait table, or the standing pose). Then [`apply_poses`] moves the meshes, whatever the
+//! level.
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
@@ -15,12 +16,18 @@ use super::player::Round;
 use super::scene::Palette;
 use crate::SimEntity;
 use crate::config::SimConfig;
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
+use crate::creature::{Creature, KindTable, PlanarState};
+use crate::gait::GaitPose;
 use crate::lod::Lod;
 use crate::models::rigid::{RigidHopper, RigidPart};
 
-/// Gravity for the drawn hop of a point mass, which has no vertical motion of its own.
-const GRAVITY_M_PER_S2: f32 = 9.81;
+/// Rapier's bodies face +x; a pose faces -z.
+const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
+    0.0,
+    std::f32::consts::FRAC_1_SQRT_2,
+    0.0,
+    std::f32::consts::FRAC_1_SQRT_2,
+);
 
 /// The two steps of drawing, in `Update`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -137,52 +144,42 @@ fn despawn_orphans(
     }
 }
 
-/// Height of the drawn hop at `cycle`: a ballistic arc over the flight part of the cycle.
-fn hop_height_m(cycle: f32, stance_fraction: f32, cycles_per_s: f32) -> f32 {
-    if cycle < stance_fraction {
-        return 0.0;
-    }
-    let flight_s = (1.0 - stance_fraction) / cycles_per_s;
-    let t = (cycle - stance_fraction) / cycles_per_s;
-    0.5 * GRAVITY_M_PER_S2 * t * (flight_s - t)
-}
-
-/// The point-mass level (paper 3.3): the body where the point mass is, facing its heading,
-/// hopping with the gait phase; the leg held at a constant angle.
-fn pose_point_masses(
-    config: Res<SimConfig>,
+/// The levels that move as a point mass and publish a [`GaitPose`]: the hybrid (paper 3.2)
+/// poses the body and leg from the gait table; the point mass (3.3) holds its kind's
+/// standing pose, the leg at a constant angle. The body stands where the point mass is,
+/// facing its heading; a two-legged kind has the leg on each side.
+fn pose_from_gait(
     kinds: Res<KindTable>,
     settings: Res<GameSettings>,
-    creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPhase)>,
+    creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPose)>,
     mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
 ) {
-    let look = &settings.creature_look;
-    let (sin, cos) = look.point_mass_leg_angle_deg.to_radians().sin_cos();
     for (visual, mut pose) in &mut visuals {
-        let Ok((creature, &Lod::PointMass, state, gait)) = creatures.get(visual.creature) else {
+        let Ok((creature, &level, state, gait)) = creatures.get(visual.creature) else {
             continue;
         };
-        let kind = &kinds[creature.kind];
-        let body_radius = kind.radius_m * look.body_radius_fraction;
-        let hip_height = config.kinds[creature.kind].body.hip_height_m;
-        let hop = hop_height_m(gait.cycle, kind.stance_fraction, kind.cycles_per_s);
-        let forward = Vec3::new(state.heading.x, 0.0, state.heading.y);
-        let centre = Vec3::new(state.position.x, hip_height + hop, state.position.y);
-        let body = Transform::from_translation(centre).looking_to(forward, Vec3::Y);
-        let side = body.right().as_vec3() * body_radius * 0.5;
-        let hip_drop = Vec3::Y * body_radius * 0.5;
-        // Long enough that the foot is on the ground in stance.
-        let leg_length = (hip_height - body_radius * 0.5) / cos;
-        let leg = (forward * sin - Vec3::Y * cos) * leg_length;
+        if !level.moves_as_point_mass() {
+            continue;
+        }
+        let body_radius = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
+        // The inverse of `rigid_pose`: rapier's body frame (x forward, y up, z to the side),
+        // yawed to the heading, then pitched and rolled.
+        let yaw = -state.heading.y.atan2(state.heading.x);
+        let rotation = Quat::from_euler(EulerRot::YZX, yaw, gait.pitch_rad, gait.roll_rad);
+        let centre = Vec3::new(state.position.x, gait.body_height_m, state.position.y);
+        let leg = rotation
+            * Vec3::new(gait.leg_forward_rad.tan(), -1.0, -gait.leg_sideways_rad.tan()).normalize()
+            * gait.leg_length_m;
+        let side = rotation * Vec3::Z * body_radius * 0.5;
         let hips: &[Vec3] = if visual.legs.len() == 2 {
-            &[centre - hip_drop - side, centre - hip_drop + side]
+            &[centre - side, centre + side]
         } else {
-            &[centre - hip_drop]
+            &[centre]
         };
-        pose.body = body;
+        pose.body = Transform::from_translation(centre).with_rotation(rotation * RAPIER_TO_POSE);
         pose.body_radius_m = body_radius;
         pose.legs = hips.iter().map(|&hip| (hip, hip + leg)).collect();
-        pose.level = Lod::PointMass;
+        pose.level = level;
     }
 }
 
@@ -194,8 +191,6 @@ fn pose_rigid_hoppers(
     parts: Query<&Transform, With<RigidPart>>,
     mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
 ) {
-    // Rapier's body faces +x; a pose faces -z.
-    let to_pose = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
     for (visual, mut pose) in &mut visuals {
         let Ok((creature, &Lod::Rigid, hopper)) = creatures.get(visual.creature) else {
             continue;
@@ -207,7 +202,7 @@ fn pose_rigid_hoppers(
         ) else {
             continue;
         };
-        pose.body = Transform::from_translation(body.translation).with_rotation(body.rotation * to_pose);
+        pose.body = Transform::from_translation(body.translation).with_rotation(body.rotation * RAPIER_TO_POSE);
         pose.body_radius_m = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
         pose.legs = vec![(hip.translation, foot.translation)];
         pose.level = Lod::Rigid;
@@ -312,7 +307,7 @@ pub(super) fn plugin(app: &mut App) {
             Update,
             (
                 (despawn_orphans, spawn_visuals).chain().before(DrawCreatures::Pose),
-                (pose_point_masses, pose_rigid_hoppers).in_set(DrawCreatures::Pose),
+                (pose_from_gait, pose_rigid_hoppers).in_set(DrawCreatures::Pose),
                 (apply_poses, mark_player).in_set(DrawCreatures::Apply),
             ),
         );
