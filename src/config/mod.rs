@@ -41,26 +41,34 @@ impl SimConfig {
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
-        Self::assemble(scenario_path, assets_root, scenario, arena, |i, kind| {
-            let path = creature_file(assets_root, kind);
-            if !path.is_file() {
-                return Err(ConfigError::one(
-                    scenario_path,
-                    format!("creatures[{i}].kind"),
-                    format!(
-                        "unknown creature kind {kind:?}: there is no {}; known kinds: {}",
-                        path.display(),
-                        known_kinds(assets_root).join(", ")
-                    ),
-                ));
-            }
-            load_file(&path)
-        })
+        Self::assemble(
+            scenario_path,
+            assets_root,
+            scenario,
+            arena,
+            |i, kind| {
+                let path = creature_file(assets_root, kind);
+                if !path.is_file() {
+                    return Err(ConfigError::one(
+                        scenario_path,
+                        format!("creatures[{i}].kind"),
+                        format!(
+                            "unknown creature kind {kind:?}: there is no {}; known kinds: {}",
+                            path.display(),
+                            known_kinds(assets_root).join(", ")
+                        ),
+                    ));
+                }
+                load_file(&path)
+            },
+            |file| load_file(&assets_root.join(file)),
+        )
     }
 
-    /// Puts a scenario together with its arena and the creature kinds it names, and checks
-    /// what spans files. `kind_def(i, k)` gives the definition of kind `k`, first named by
-    /// creature group `i`: read from disk by [`SimConfig::load`], taken from the asset
+    /// Puts a scenario together with its arena, the creature kinds it names and their gait
+    /// tables, and checks what spans files. `kind_def(i, k)` gives the definition of kind
+    /// `k`, first named by creature group `i`; `gait_table(f)` the table in file `f` (under
+    /// the assets folder). Read from disk by [`SimConfig::load`], taken from the asset
     /// server by the game, so both check the same things.
     pub fn assemble(
         scenario_path: &Path,
@@ -68,6 +76,7 @@ impl SimConfig {
         scenario: Scenario,
         arena: ArenaConfig,
         mut kind_def: impl FnMut(usize, &str) -> Result<CreatureDef, ConfigError>,
+        mut gait_table: impl FnMut(&str) -> Result<GaitTable, ConfigError>,
     ) -> Result<Self, ConfigError> {
         let mut kinds = Vec::with_capacity(scenario.creatures.len());
         for (i, group) in scenario.creatures.iter().enumerate() {
@@ -86,7 +95,7 @@ impl SimConfig {
         }
         let gaits = kinds
             .iter()
-            .map(|k| load_gait(assets_root, k))
+            .map(|k| gait_of(assets_root, k, &mut gait_table))
             .collect::<Result<_, _>>()?;
         let config = Self {
             scenario,
@@ -122,13 +131,16 @@ impl SimConfig {
 }
 
 /// A kind's gait table, checked to be recorded for that kind.
-fn load_gait(assets_root: &Path, kind: &CreatureDef) -> Result<Option<GaitTable>, ConfigError> {
+fn gait_of(
+    assets_root: &Path,
+    kind: &CreatureDef,
+    gait_table: &mut impl FnMut(&str) -> Result<GaitTable, ConfigError>,
+) -> Result<Option<GaitTable>, ConfigError> {
     let Some(file) = &kind.gait_table else { return Ok(None) };
-    let path = assets_root.join(file);
-    let table: GaitTable = load_file(&path)?;
+    let table = gait_table(file)?;
     if table.creature != kind.name {
         return Err(ConfigError::one(
-            &path,
+            &assets_root.join(file),
             "creature",
             format!("the table was recorded for {:?}, not {:?}", table.creature, kind.name),
         ));

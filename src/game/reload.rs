@@ -1,4 +1,4 @@
-//! Hot reload: the scenario, arena, creature and game files load through Bevy's asset
+//! Hot reload: the scenario, arena, creature, gait-table and game files load through Bevy's asset
 //! server, which watches them. A good edit of a simulation file starts a new round from the
 //! edited files; a good edit of `game.ron` changes the looks at once. A bad edit is shown
 //! on screen and everything runs on with the last good values.
@@ -11,6 +11,7 @@ use std::path::{Path, PathBuf};
 use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
 use crate::config::{ArenaConfig, ConfigError, CreatureDef, GameConfig, Scenario, SimConfig, creature_file};
+use crate::gait::GaitTable;
 
 /// The files the game watches, and whether one changed since the config was last put
 /// together from them.
@@ -22,6 +23,8 @@ pub struct Watched {
     scenario: Handle<Scenario>,
     arena: Handle<ArenaConfig>,
     kinds: HashMap<String, Handle<CreatureDef>>,
+    /// Gait tables by file.
+    gaits: HashMap<String, Handle<GaitTable>>,
     game: Handle<GameConfig>,
     changed: bool,
 }
@@ -34,6 +37,7 @@ impl Watched {
             scenario: default(),
             arena: default(),
             kinds: default(),
+            gaits: default(),
             game: default(),
             changed: false,
         }
@@ -47,6 +51,7 @@ impl Watched {
             || id == self.arena.id().untyped()
             || id == self.game.id().untyped()
             || self.kinds.values().any(|h| id == h.id().untyped())
+            || self.gaits.values().any(|h| id == h.id().untyped())
     }
 }
 
@@ -64,6 +69,10 @@ fn watch_files(server: Res<AssetServer>, base: Res<BaseConfig>, mut watched: Res
     for kind in &base.kinds {
         let handle = server.load(kind_file(&kind.name));
         watched.kinds.insert(kind.name.clone(), handle);
+        if let Some(file) = &kind.gait_table {
+            let handle = server.load(file.clone());
+            watched.gaits.insert(file.clone(), handle);
+        }
     }
 }
 
@@ -124,6 +133,7 @@ fn assemble(
     scenarios: &Assets<Scenario>,
     arenas: &Assets<ArenaConfig>,
     kinds: &Assets<CreatureDef>,
+    gaits: &Assets<GaitTable>,
 ) -> Result<Option<SimConfig>, ConfigError> {
     let Some(scenario) = scenarios.get(&watched.scenario) else {
         return Ok(None);
@@ -138,7 +148,17 @@ fn assemble(
             .kinds
             .entry(group.kind.clone())
             .or_insert_with(|| server.load(kind_file(&group.kind)));
-        waiting |= kinds.get(&*handle).is_none();
+        let Some(kind) = kinds.get(&*handle) else {
+            waiting = true;
+            continue;
+        };
+        if let Some(file) = &kind.gait_table {
+            let gait = watched
+                .gaits
+                .entry(file.clone())
+                .or_insert_with(|| server.load(file.clone()));
+            waiting |= gaits.get(&*gait).is_none();
+        }
     }
     let Some(arena) = arenas.get(&watched.arena) else {
         return Ok(None);
@@ -153,6 +173,7 @@ fn assemble(
         scenario.clone(),
         arena.clone(),
         |_, kind| Ok(kinds.get(&watched.kinds[kind]).expect("loaded").clone()),
+        |file| Ok(gaits.get(&watched.gaits[file]).expect("loaded").clone()),
     )
     .map(Some)
 }
@@ -163,6 +184,7 @@ fn apply_changes(
     scenarios: Res<Assets<Scenario>>,
     arenas: Res<Assets<ArenaConfig>>,
     kinds: Res<Assets<CreatureDef>>,
+    gaits: Res<Assets<GaitTable>>,
     mut watched: ResMut<Watched>,
     mut problems: ResMut<Problems>,
     mut base: ResMut<BaseConfig>,
@@ -171,13 +193,16 @@ fn apply_changes(
     if !watched.changed {
         return;
     }
-    match assemble(&mut watched, &server, &scenarios, &arenas, &kinds) {
+    match assemble(&mut watched, &server, &scenarios, &arenas, &kinds, &gaits) {
         Ok(None) => return,
         Ok(Some(mut config)) => {
             problems.0.remove(ACROSS_FILES);
             // The level policy is the player's (`--policy`, the L key), not the file's.
             config.scenario.level_policy = base.scenario.level_policy;
-            let same = config.scenario == base.scenario && config.arena == base.arena && config.kinds == base.kinds;
+            let same = config.scenario == base.scenario
+                && config.arena == base.arena
+                && config.kinds == base.kinds
+                && config.gaits == base.gaits;
             if !same {
                 base.0 = config;
                 rounds.write(NewRound);
@@ -208,10 +233,12 @@ pub fn plugin(app: &mut App) {
                     note_failures::<Scenario>,
                     note_failures::<ArenaConfig>,
                     note_failures::<CreatureDef>,
+                    note_failures::<GaitTable>,
                     note_failures::<GameConfig>,
                     note_changes::<Scenario>,
                     note_changes::<ArenaConfig>,
                     note_changes::<CreatureDef>,
+                    note_changes::<GaitTable>,
                     note_changes::<GameConfig>,
                 ),
                 apply_changes,

@@ -97,15 +97,19 @@ fn update_until(app: &mut App, what: &str, done: impl Fn(&mut App) -> bool) {
 }
 
 fn copy_assets(test: &str) -> std::path::PathBuf {
-    let dir = scratch_dir(test);
-    for sub in ["", "creatures", "scenarios"] {
-        std::fs::create_dir_all(dir.join(sub)).unwrap();
-        for entry in std::fs::read_dir(assets_root().join(sub)).unwrap().flatten() {
-            if entry.path().is_file() {
-                std::fs::copy(entry.path(), dir.join(sub).join(entry.file_name())).unwrap();
+    fn copy_dir(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).unwrap();
+        for entry in std::fs::read_dir(from).unwrap().flatten() {
+            let (path, target) = (entry.path(), to.join(entry.file_name()));
+            if path.is_dir() {
+                copy_dir(&path, &target);
+            } else {
+                std::fs::copy(&path, &target).unwrap();
             }
         }
     }
+    let dir = scratch_dir(test);
+    copy_dir(&assets_root(), &dir);
     dir
 }
 
@@ -191,4 +195,40 @@ fn without_a_display_the_game_says_so_in_one_sentence_and_points_to_run() {
         "{stderr}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn an_edited_gait_table_is_watched_like_the_other_files() {
+    let root = copy_assets("hot_reload_gait");
+    let mut app = watching_app(&root);
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let file = root.join("gaits/hopper.ron");
+    let table = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: -1.0", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the bad gait table's problem", |app| {
+        app.world()
+            .resource::<Problems>()
+            .0
+            .values()
+            .any(|p| p.contains("top_speed_m_per_s"))
+    });
+    assert_eq!(app.world().resource::<Round>().number, 0);
+    std::fs::write(
+        &file,
+        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: 2.5", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the good gait table", |app| {
+        app.world().resource::<Round>().number == 1
+    });
+    let config = app.world().resource::<SimConfig>();
+    assert_eq!(config.gaits[0].as_ref().unwrap().top_speed_m_per_s, 2.5);
+    assert!(app.world().resource::<Problems>().0.is_empty());
 }
