@@ -80,7 +80,7 @@ fn read_game_keys(
         // Every policy there is, in turn. A policy picks each creature's level when it
         // spawns, so a new round starts with it (and later rounds keep it).
         let all = LevelPolicy::value_variants();
-        let now = all.iter().position(|&p| p == config.scenario.level_policy).unwrap_or(0);
+        let now = all.iter().position(|&p| p == base.scenario.level_policy).unwrap_or(0);
         let next = all[(now + 1) % all.len()];
         base.scenario.level_policy = next;
         rounds.write(NewRound);
