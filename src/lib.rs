@@ -39,13 +39,15 @@ pub mod config;
 pub mod creature;
 pub mod experiments;
 pub mod gait;
+#[cfg(feature = "game")]
+pub mod game;
 pub mod headless;
 pub mod lod;
 pub mod models;
 pub mod outcome;
 pub mod sense;
 
-use bevy::ecs::schedule::SingleThreadedExecutor;
+use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use rand::SeedableRng;
@@ -64,6 +66,15 @@ pub enum SimStage {
     Observe,
     Outcome,
 }
+
+/// Builds the simulated world from [`SimConfig`]: run once at `Startup`, and again by
+/// [`start_over`]. Each module adds the systems that set up its part of the world here.
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SimStart;
+
+/// Part of the simulated world (court, puck, creatures): removed when the world starts over.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct SimEntity;
 
 /// The world's one random number generator, seeded from the scenario (or `--seed`).
 #[derive(Resource)]
@@ -102,24 +113,69 @@ pub struct SimPlugin {
     pub config: SimConfig,
 }
 
+/// The resources a run starts from: the config, its seeded RNG, a clock at tick 0, and the
+/// fixed timestep (rapier reads its own copy).
+fn insert_run_resources(world: &mut World, config: SimConfig) {
+    let scenario = &config.scenario;
+    let dt = 1.0 / scenario.tick_hz as f32;
+    world.insert_resource(WorldRng(StdRng::seed_from_u64(scenario.seed)));
+    world.insert_resource(SimClock {
+        tick: 0,
+        dt,
+        tick_hz: scenario.tick_hz,
+        ticks_per_decision: scenario.ticks_per_decision(),
+    });
+    world.insert_resource(Time::<Fixed>::from_seconds(f64::from(dt)));
+    world.insert_resource(TimestepMode::Fixed { dt, substeps: 1 });
+    world.insert_resource(config);
+}
+
+/// Starts the simulation over from `config`, as if the app had just been built with it:
+/// every [`SimEntity`] is removed and [`SimStart`] builds the world again. The game calls it
+/// for a new round and when an asset file is edited; call it between ticks.
+pub fn start_over(world: &mut World, config: SimConfig) {
+    let old: Vec<Entity> = world.query_filtered::<Entity, With<SimEntity>>().iter(world).collect();
+    for entity in old {
+        world.despawn(entity);
+    }
+    empty_physics(world);
+    insert_run_resources(world, config);
+    world.run_schedule(SimStart);
+}
+
+/// Empties rapier's world rather than letting it remove the old bodies one by one: freed
+/// handles would be reused in another order, and with them the solver's order, so a new
+/// round would not match a fresh start with the same seed.
+fn empty_physics(world: &mut World) {
+    let mut contexts = world.query::<(
+        &mut RapierContextSimulation,
+        &mut RapierContextColliders,
+        &mut RapierRigidBodySet,
+        &mut RapierContextJoints,
+    )>();
+    for (mut simulation, mut colliders, mut bodies, mut joints) in contexts.iter_mut(world) {
+        let parameters = simulation.integration_parameters;
+        *simulation = default();
+        simulation.integration_parameters = parameters;
+        *colliders = default();
+        *bodies = default();
+        *joints = default();
+    }
+}
+
+fn run_sim_start(world: &mut World) {
+    world.run_schedule(SimStart);
+}
+
 impl Plugin for SimPlugin {
     fn build(&self, app: &mut App) {
-        let scenario = &self.config.scenario;
-        let dt = 1.0 / scenario.tick_hz as f32;
         if !app.is_plugin_added::<TransformPlugin>() {
             app.add_plugins(TransformPlugin);
         }
-        app.insert_resource(self.config.clone())
-            .insert_resource(WorldRng(StdRng::seed_from_u64(scenario.seed)))
-            .insert_resource(SimClock {
-                tick: 0,
-                dt,
-                tick_hz: scenario.tick_hz,
-                ticks_per_decision: scenario.ticks_per_decision(),
-            })
-            .insert_resource(Time::<Fixed>::from_seconds(f64::from(dt)))
-            .insert_resource(TimestepMode::Fixed { dt, substeps: 1 })
-            .add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
+        insert_run_resources(app.world_mut(), self.config.clone());
+        app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
+            .init_schedule(SimStart)
+            .add_systems(Startup, run_sim_start)
             .configure_sets(
                 FixedUpdate,
                 (

@@ -1,4 +1,5 @@
-//! The `simlod` command line: the headless simulation and its measurements.
+//! The `simlod` command line: the game (the default), the headless simulation and its
+//! measurements.
 
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
@@ -17,12 +18,16 @@ use simlod::{bench, experiments, headless};
     about = "Simulation levels of detail for real-time animation (Carlson & Hodgins, GI '97)"
 )]
 struct Cli {
+    /// Without a command: `play` (in a build with the `game` feature).
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// Play the game in a window (the default).
+    #[cfg(feature = "game")]
+    Play(PlayArgs),
     /// Simulate a scenario without a window, as fast as the machine allows, and summarise it.
     Run(RunArgs),
     /// Measure the cost per creature per 1/30 s of motion and the most creatures at 30 fps.
@@ -192,6 +197,39 @@ impl ScenarioArgs {
     }
 }
 
+/// `Parser` too, so that `simlod` alone plays with the defaults.
+#[cfg(feature = "game")]
+#[derive(Parser)]
+struct PlayArgs {
+    /// The scenario file; it must be inside the assets folder, which the game watches.
+    #[arg(long, default_value = "assets/scenarios/default.ron")]
+    scenario: PathBuf,
+    /// The assets folder: the scenario's arena and creature kinds, and `game.ron`.
+    #[arg(long, default_value = "assets")]
+    assets: PathBuf,
+    /// Overrides the scenario's level policy (L switches it while playing).
+    #[arg(long, value_enum)]
+    policy: Option<LevelPolicy>,
+    /// Render `--frames` frames, save the window to this PNG file and quit.
+    #[arg(long, requires = "frames")]
+    screenshot: Option<PathBuf>,
+    /// Frames to render before the screenshot.
+    #[arg(long, requires = "screenshot", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    frames: Option<u32>,
+}
+
+#[cfg(feature = "game")]
+impl PlayArgs {
+    fn play(self) -> Result<(), String> {
+        simlod::game::play(simlod::game::PlayOptions {
+            scenario: self.scenario,
+            assets: self.assets,
+            policy: self.policy,
+            screenshot: self.screenshot.zip(self.frames),
+        })
+    }
+}
+
 #[derive(Args)]
 struct RunArgs {
     #[command(flatten)]
@@ -259,7 +297,16 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Run(args) => args.scenario.load().map(|config| {
+        #[cfg(feature = "game")]
+        None => PlayArgs::parse_from(["play"]).play(),
+        #[cfg(not(feature = "game"))]
+        None => Err(
+            "this build has no game window (built without the `game` feature); `simlod run` simulates without one"
+                .to_owned(),
+        ),
+        #[cfg(feature = "game")]
+        Some(Command::Play(args)) => args.play(),
+        Some(Command::Run(args)) => args.scenario.load().map(|config| {
             let seconds = args.seconds.unwrap_or(f64::from(config.scenario.duration_s));
             let summary = headless::run(config.clone(), seconds);
             if args.json {
@@ -268,19 +315,19 @@ fn main() -> ExitCode {
                 print_summary(&args, &summary, &config);
             }
         }),
-        Command::RecordGait(args) => args.run(),
-        Command::Bench(args) => args
+        Some(Command::RecordGait(args)) => args.run(),
+        Some(Command::Bench(args)) => args
             .scenario
             .load()
             .map(|config| bench::run(&config, args.quick, args.json)),
-        Command::Experiment(ExperimentArgs {
+        Some(Command::Experiment(ExperimentArgs {
             which:
                 ExperimentKind::StepResponse {
                     scenario,
                     experiment,
                     out,
                 },
-        }) => scenario
+        })) => scenario
             .load()
             .and_then(|config| experiments::step_response::run(&config, &experiment, &out))
             .map(|summary| print!("{summary}")),

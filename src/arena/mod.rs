@@ -9,7 +9,7 @@ use bevy_rapier3d::prelude::*;
 use rand::RngExt;
 
 use crate::config::SimConfig;
-use crate::{SimStage, WorldRng};
+use crate::{SimEntity, SimStage, SimStart, WorldRng};
 
 /// The court's inside, on the ground plane.
 #[derive(Resource, Clone, Copy, Debug)]
@@ -48,12 +48,18 @@ fn launch_direction(rng: &mut WorldRng) -> Vec2 {
 pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let arena = &config.arena;
     let half = arena.half_extents();
+    commands.insert_resource(Court { half_extents: half });
+    commands.insert_resource(PuckState {
+        radius_m: arena.puck.radius_m,
+        ..default()
+    });
     let (t, h) = (arena.wall_thickness_m, arena.wall_height_m);
     // Ground: a slab whose top is y = 0.
     commands.spawn((
         Name::new("ground"),
         Ground,
         Friction::coefficient(1.0),
+        SimEntity,
         RigidBody::Fixed,
         Collider::cuboid(half.x + t, 0.5, half.y + t),
         Transform::from_xyz(0.0, -0.5, 0.0),
@@ -83,6 +89,7 @@ pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rn
         commands.spawn((
             Name::new(name),
             Wall,
+            SimEntity,
             RigidBody::Fixed,
             Collider::cuboid(extents.x, extents.y, extents.z),
             Restitution {
@@ -97,6 +104,7 @@ pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rn
     commands.spawn((
         Name::new("puck"),
         Puck,
+        SimEntity,
         RigidBody::Dynamic,
         Collider::cylinder(puck.height_m / 2.0, puck.radius_m),
         ColliderMassProperties::Mass(puck.mass_kg),
@@ -138,16 +146,6 @@ fn drive_puck(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    let config = app.world().resource::<SimConfig>();
-    let court = Court {
-        half_extents: config.arena.half_extents(),
-    };
-    let puck = PuckState {
-        radius_m: config.arena.puck.radius_m,
-        ..default()
-    };
-    app.insert_resource(court)
-        .insert_resource(puck)
-        .add_systems(Startup, spawn_arena)
+    app.add_systems(SimStart, spawn_arena)
         .add_systems(FixedUpdate, drive_puck.in_set(SimStage::Sense));
 }

@@ -6,6 +6,7 @@
 
 mod arena;
 mod creature;
+mod game;
 mod loader;
 mod rules;
 mod scenario;
@@ -13,6 +14,7 @@ mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
 pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConfig, SteeringConfig};
+pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
@@ -42,28 +44,55 @@ impl SimConfig {
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
+        let rules: LevelRules = load_file(&assets_root.join(&scenario.level_rules))?;
+        Self::assemble(
+            scenario_path,
+            assets_root,
+            scenario,
+            arena,
+            rules,
+            |i, kind| {
+                let path = creature_file(assets_root, kind);
+                if !path.is_file() {
+                    return Err(ConfigError::one(
+                        scenario_path,
+                        format!("creatures[{i}].kind"),
+                        format!(
+                            "unknown creature kind {kind:?}: there is no {}; known kinds: {}",
+                            path.display(),
+                            known_kinds(assets_root).join(", ")
+                        ),
+                    ));
+                }
+                load_file(&path)
+            },
+            |file| load_file(&assets_root.join(file)),
+        )
+    }
+
+    /// Puts a scenario together with its arena, its level rules, the creature kinds it names
+    /// and their gait tables, and checks what spans files. `kind_def(i, k)` gives the definition of kind
+    /// `k`, first named by creature group `i`; `gait_table(f)` the table in file `f` (under
+    /// the assets folder). Read from disk by [`SimConfig::load`], taken from the asset
+    /// server by the game, so both check the same things.
+    pub fn assemble(
+        scenario_path: &Path,
+        assets_root: &Path,
+        scenario: Scenario,
+        arena: ArenaConfig,
+        rules: LevelRules,
+        mut kind_def: impl FnMut(usize, &str) -> Result<CreatureDef, ConfigError>,
+        mut gait_table: impl FnMut(&str) -> Result<GaitTable, ConfigError>,
+    ) -> Result<Self, ConfigError> {
         let mut kinds = Vec::with_capacity(scenario.creatures.len());
         for (i, group) in scenario.creatures.iter().enumerate() {
             if kinds.iter().any(|k: &CreatureDef| k.name == group.kind) {
                 continue;
             }
-            let path = creature_file(assets_root, &group.kind);
-            if !path.is_file() {
-                return Err(ConfigError::one(
-                    scenario_path,
-                    format!("creatures[{i}].kind"),
-                    format!(
-                        "unknown creature kind {:?}: there is no {}; known kinds: {}",
-                        group.kind,
-                        path.display(),
-                        known_kinds(assets_root).join(", ")
-                    ),
-                ));
-            }
-            let def: CreatureDef = load_file(&path)?;
+            let def = kind_def(i, &group.kind)?;
             if def.name != group.kind {
                 return Err(ConfigError::one(
-                    &path,
+                    &creature_file(assets_root, &group.kind),
                     "name",
                     format!("is {:?} but the file is named for kind {:?}", def.name, group.kind),
                 ));
@@ -72,9 +101,8 @@ impl SimConfig {
         }
         let gaits = kinds
             .iter()
-            .map(|k| load_gait(assets_root, k))
+            .map(|k| gait_of(assets_root, k, &mut gait_table))
             .collect::<Result<_, _>>()?;
-        let rules: LevelRules = load_file(&assets_root.join(&scenario.level_rules))?;
         let config = Self {
             scenario,
             arena,
@@ -110,13 +138,16 @@ impl SimConfig {
 }
 
 /// A kind's gait table, checked to be recorded for that kind.
-fn load_gait(assets_root: &Path, kind: &CreatureDef) -> Result<Option<GaitTable>, ConfigError> {
+fn gait_of(
+    assets_root: &Path,
+    kind: &CreatureDef,
+    gait_table: &mut impl FnMut(&str) -> Result<GaitTable, ConfigError>,
+) -> Result<Option<GaitTable>, ConfigError> {
     let Some(file) = &kind.gait_table else { return Ok(None) };
-    let path = assets_root.join(file);
-    let table: GaitTable = load_file(&path)?;
+    let table = gait_table(file)?;
     if table.creature != kind.name {
         return Err(ConfigError::one(
-            &path,
+            &assets_root.join(file),
             "creature",
             format!("the table was recorded for {:?}, not {:?}", table.creature, kind.name),
         ));
@@ -150,15 +181,17 @@ fn known_kinds(assets_root: &Path) -> Vec<String> {
 /// Registers the asset types and their loader with Bevy's asset server, when it is present.
 pub fn plugin(app: &mut App) {
     if app.is_plugin_added::<bevy::asset::AssetPlugin>() {
-        // All three share the `.ron` extension: the asset server picks the loader by the
+        // All share the `.ron` extension: the asset server picks the loader by the
         // asset type asked for.
         app.init_asset::<Scenario>()
             .init_asset::<ArenaConfig>()
             .init_asset::<CreatureDef>()
             .init_asset::<LevelRules>()
             .init_asset_loader::<RonAssetLoader<LevelRules>>()
+            .init_asset::<GameConfig>()
             .init_asset_loader::<RonAssetLoader<Scenario>>()
             .init_asset_loader::<RonAssetLoader<ArenaConfig>>()
-            .init_asset_loader::<RonAssetLoader<CreatureDef>>();
+            .init_asset_loader::<RonAssetLoader<CreatureDef>>()
+            .init_asset_loader::<RonAssetLoader<GameConfig>>();
     }
 }

@@ -6,16 +6,25 @@ use bevy::prelude::*;
 use rand::RngExt;
 use std::ops::Index;
 
-use crate::WorldRng;
 use crate::config::{CreatureDef, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable};
 use crate::lod::{LevelChoice, Lod};
 use crate::outcome::CollisionRecord;
+use crate::{SimEntity, SimStart, WorldRng};
 use std::collections::HashMap;
 
 /// A legged creature. Its level of detail is the [`Lod`] component beside it.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Eq)]
-#[require(Lod, LevelChoice, PlanarState, GaitPhase, GaitPose, DesiredVelocity, CollisionRecord)]
+#[require(
+    Lod,
+    LevelChoice,
+    PlanarState,
+    GaitPhase,
+    GaitPose,
+    DesiredVelocity,
+    CollisionRecord,
+    SimEntity
+)]
 pub struct Creature {
     /// Index into [`KindTable`] (and [`SimConfig::kinds`]).
     pub kind: usize,
@@ -245,14 +254,17 @@ impl Occupancy {
     }
 }
 
-/// Places the scenario's creatures in free parts of the court.
-fn spawn_creatures(
-    mut commands: Commands,
-    config: Res<SimConfig>,
-    kinds: Res<KindTable>,
-    mut rng: ResMut<WorldRng>,
-    mut serials: ResMut<SerialCounter>,
-) {
+/// Places the scenario's creatures in free parts of the court, numbered from 0.
+fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
+    let kinds = KindTable(
+        config
+            .kinds
+            .iter()
+            .zip(&config.gaits)
+            .map(|(d, g)| KindParams::new(d, g.as_ref()))
+            .collect(),
+    );
+    let mut serials = SerialCounter::default();
     let half = config.arena.half_extents();
     let clear = config.arena.respawn_creature_clearance_m;
     let biggest = config.kinds.iter().map(|k| k.body.radius_m).fold(0.0, f32::max);
@@ -285,20 +297,11 @@ fn spawn_creatures(
         }
     }
     commands.spawn_batch(batch);
+    commands.insert_resource(serials);
+    commands.insert_resource(kinds);
 }
 
 pub(super) fn plugin(app: &mut App) {
-    let config = app.world().resource::<SimConfig>();
-    let kinds = KindTable(
-        config
-            .kinds
-            .iter()
-            .zip(&config.gaits)
-            .map(|(d, g)| KindParams::new(d, g.as_ref()))
-            .collect(),
-    );
-    app.insert_resource(kinds)
-        .init_resource::<SerialCounter>()
-        .add_systems(Startup, spawn_creatures.after(crate::arena::spawn_arena));
+    app.add_systems(SimStart, spawn_creatures.after(crate::arena::spawn_arena));
     steering::plugin(app);
 }

@@ -17,7 +17,7 @@ use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::models::rigid::{Raibert, RigidHopper};
 use crate::outcome::CollisionRecord;
-use crate::{SimClock, SimStage};
+use crate::{SimClock, SimStage, SimStart};
 
 /// A creature changed level.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -136,9 +136,14 @@ fn count_levels(clock: Res<SimClock>, mut tally: ResMut<SwitchTally>, levels: Qu
     }
 }
 
+fn reset_switch_tally(mut tally: ResMut<SwitchTally>) {
+    *tally = SwitchTally::default();
+}
+
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<SwitchTally>()
         .add_message::<LevelSwitched>()
+        .add_systems(SimStart, reset_switch_tally)
         .add_systems(
             FixedUpdate,
             switch_levels.in_set(SimStage::Switch).run_if(dynamic_policy),

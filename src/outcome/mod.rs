@@ -20,7 +20,7 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot};
 use crate::lod::{Lod, SwitchTally};
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage, WorldRng};
+use crate::{SimClock, SimStage, SimStart, WorldRng};
 
 /// What a creature can collide with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -339,9 +339,15 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     }
 }
 
+/// A new run counts from zero.
+fn reset_tally(mut tally: ResMut<Tally>) {
+    *tally = Tally::default();
+}
+
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<FallQueue>()
         .init_resource::<Tally>()
+        .add_systems(SimStart, reset_tally)
         .add_systems(FixedUpdate, detect_collisions.in_set(SimStage::Observe))
         .add_systems(
             FixedUpdate,

@@ -5,7 +5,7 @@ use bevy::prelude::*;
 
 use crate::config::SimConfig;
 use crate::creature::{Creature, KindTable, PlanarState};
-use crate::{SimClock, SimStage};
+use crate::{SimClock, SimStage, SimStart};
 
 /// What a creature knows of a neighbour: a snapshot taken when the index was built.
 #[derive(Clone, Copy, Debug)]
@@ -148,15 +148,18 @@ fn index_creatures(
     }));
 }
 
-pub(super) fn plugin(app: &mut App) {
-    let config = app.world().resource::<SimConfig>();
+/// A grid sized for the court and the largest creature's reach.
+fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
     let cell_m = config
         .kinds
         .iter()
         .map(|k| k.steering.separation_distance_m.max(4.0 * k.body.radius_m))
         .fold(0.5, f32::max);
-    let grid = NeighbourGrid::new(config.arena.half_extents(), cell_m);
-    app.insert_resource(grid)
+    commands.insert_resource(NeighbourGrid::new(config.arena.half_extents(), cell_m));
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.add_systems(SimStart, size_grid)
         .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
 }
 

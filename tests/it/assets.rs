@@ -11,7 +11,7 @@ use simlod::config::{ArenaConfig, ConfigError, CreatureDef, Scenario, SimConfig,
 /// A copy of the shipped assets in a scratch folder, with one file replaced.
 fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
     let dir = scratch_dir(test);
-    for sub in ["", "creatures", "scenarios"] {
+    for sub in ["", "creatures", "scenarios", "rules", "gaits"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
         for entry in std::fs::read_dir(assets_root().join(sub)).unwrap().flatten() {
             if entry.path().is_file() {

@@ -6,7 +6,11 @@ mod court;
 mod determinism;
 mod experiments;
 mod gait;
+#[cfg(feature = "game")]
+mod game;
 mod outcome;
+mod player;
+mod restart;
 mod rigid;
 mod steering;
 mod support;

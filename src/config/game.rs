@@ -1,0 +1,188 @@
+//! How the game looks: `assets/game.ron` (cameras, colours, light, HUD, creature drawing).
+//! Read by the game only; the simulation never sees it.
+
+use super::{Validate, Validator};
+use crate::lod::Lod;
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A colour as sRGB components in `[0, 1]`.
+pub type Srgb = [f32; 3];
+
+#[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GameConfig {
+    pub camera: CameraConfig,
+    pub inset: InsetConfig,
+    /// The colour of each level of detail (paper figures 5 and 6: rigid yellow, hybrid blue);
+    /// every level needs one.
+    pub level_colours_srgb: BTreeMap<Lod, Srgb>,
+    pub scene_colours: SceneColours,
+    pub lighting: LightingConfig,
+    pub hud: HudConfig,
+    pub creature_look: CreatureLook,
+}
+
+/// The player's view (paper figure 6, bottom): behind the player on the line from the puck,
+/// so that the puck stays in view.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraConfig {
+    /// How far behind the player the camera sits, away from the puck.
+    pub follow_distance_m: f32,
+    pub follow_height_m: f32,
+    /// Where the camera aims: 0 at the player, 1 at the puck.
+    pub aim_toward_puck_fraction: f32,
+    /// How fast the camera catches up with where it wants to be (per second).
+    pub follow_rate_per_s: f32,
+    pub field_of_view_deg: f32,
+}
+
+/// The overhead view of the whole court (paper figures 5 and 6, top), in a window corner.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InsetConfig {
+    /// Width of the inset as a share of the window's width.
+    pub width_fraction: f32,
+    /// Gap between the inset and the window's edges.
+    pub margin_px: f32,
+    /// Ground shown around the court.
+    pub border_m: f32,
+    /// Creatures are tiny seen from above: each gets a dot this big, seen only from above.
+    pub creature_dot_radius_m: f32,
+    /// The player's view, drawn from above as a fan (paper figure 6, top).
+    pub view_cone_length_m: f32,
+    pub view_cone_opacity: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneColours {
+    pub sky_srgb: Srgb,
+    pub floor_srgb: Srgb,
+    pub court_lines_srgb: Srgb,
+    pub wall_srgb: Srgb,
+    pub puck_srgb: Srgb,
+    pub leg_srgb: Srgb,
+    /// Creature bodies when colouring by level is off.
+    pub uncoloured_srgb: Srgb,
+    /// The ring under the player's creature.
+    pub player_marker_srgb: Srgb,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightingConfig {
+    pub sun_illuminance_lux: f32,
+    /// Height of the sun above the horizon.
+    pub sun_elevation_deg: f32,
+    /// Direction the sunlight comes from, around the vertical, from +x towards +z.
+    pub sun_azimuth_deg: f32,
+    /// Fill light everywhere, so shadows are not black.
+    pub ambient_brightness_cd_per_m2: f32,
+    /// Shadows are cast up to this far from the camera.
+    pub shadow_distance_m: f32,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HudConfig {
+    pub font_size_px: f32,
+    /// The game-over banner.
+    pub banner_font_size_px: f32,
+    /// The HUD's frame rate and simulation time are averaged over this long.
+    pub smoothing_s: f32,
+    /// One press of `[` `]` or `-` `=` changes a radius of influence by this much.
+    pub radius_step_m: f32,
+}
+
+/// How a creature is drawn from its body size in its creature file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CreatureLook {
+    /// Body radius as a share of the creature's footprint radius (`body.radius_m`).
+    pub body_radius_fraction: f32,
+    /// The body is an ellipsoid: its length (along the heading) and height as shares of
+    /// its width.
+    pub body_length_ratio: f32,
+    pub body_height_ratio: f32,
+    pub leg_thickness_m: f32,
+    /// Kinds drawn with two legs (the biped); the others have one.
+    pub two_legged_kinds: Vec<String>,
+}
+
+fn colour(v: &mut Validator, field: &str, c: Srgb) {
+    v.nested(field, |v| {
+        for (i, x) in c.into_iter().enumerate() {
+            v.within(&i.to_string(), x, 0.0, 1.0);
+        }
+    });
+}
+
+impl Validate for GameConfig {
+    fn validate(&self, v: &mut Validator) {
+        let c = &self.camera;
+        v.nested("camera", |v| {
+            v.positive("follow_distance_m", c.follow_distance_m);
+            v.positive("follow_height_m", c.follow_height_m);
+            v.within("aim_toward_puck_fraction", c.aim_toward_puck_fraction, 0.0, 1.0);
+            v.positive("follow_rate_per_s", c.follow_rate_per_s);
+            v.within("field_of_view_deg", c.field_of_view_deg, 10.0, 150.0);
+        });
+        let i = &self.inset;
+        v.nested("inset", |v| {
+            v.within("width_fraction", i.width_fraction, 0.05, 0.9);
+            v.within("margin_px", i.margin_px, 0.0, 200.0);
+            v.non_negative("border_m", i.border_m);
+            v.positive("creature_dot_radius_m", i.creature_dot_radius_m);
+            v.positive("view_cone_length_m", i.view_cone_length_m);
+            v.within("view_cone_opacity", i.view_cone_opacity, 0.0, 1.0);
+        });
+        v.nested("level_colours_srgb", |v| {
+            for level in Lod::ALL {
+                match self.level_colours_srgb.get(&level) {
+                    Some(&c) => colour(v, &format!("{level:?}"), c),
+                    None => v.fail(&format!("{level:?}"), "every level needs a colour"),
+                }
+            }
+        });
+        let s = &self.scene_colours;
+        v.nested("scene_colours", |v| {
+            for (field, c) in [
+                ("sky_srgb", s.sky_srgb),
+                ("floor_srgb", s.floor_srgb),
+                ("court_lines_srgb", s.court_lines_srgb),
+                ("wall_srgb", s.wall_srgb),
+                ("puck_srgb", s.puck_srgb),
+                ("leg_srgb", s.leg_srgb),
+                ("uncoloured_srgb", s.uncoloured_srgb),
+                ("player_marker_srgb", s.player_marker_srgb),
+            ] {
+                colour(v, field, c);
+            }
+        });
+        let l = &self.lighting;
+        v.nested("lighting", |v| {
+            v.non_negative("sun_illuminance_lux", l.sun_illuminance_lux);
+            v.within("sun_elevation_deg", l.sun_elevation_deg, 1.0, 90.0);
+            v.within("sun_azimuth_deg", l.sun_azimuth_deg, -360.0, 360.0);
+            v.non_negative("ambient_brightness_cd_per_m2", l.ambient_brightness_cd_per_m2);
+            v.positive("shadow_distance_m", l.shadow_distance_m);
+        });
+        let h = &self.hud;
+        v.nested("hud", |v| {
+            v.within("font_size_px", h.font_size_px, 6.0, 200.0);
+            v.within("banner_font_size_px", h.banner_font_size_px, 6.0, 400.0);
+            v.positive("smoothing_s", h.smoothing_s);
+            v.within("radius_step_m", h.radius_step_m, 0.1, 10.0);
+        });
+        let k = &self.creature_look;
+        v.nested("creature_look", |v| {
+            v.within("body_radius_fraction", k.body_radius_fraction, 0.1, 3.0);
+            v.within("body_length_ratio", k.body_length_ratio, 0.2, 5.0);
+            v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
+            v.positive("leg_thickness_m", k.leg_thickness_m);
+        });
+    }
+}

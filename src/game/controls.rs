@@ -1,0 +1,160 @@
+//! The keyboard: steering the player's creature, new rounds, and live tuning of what the
+//! paper's figures 8 and 9 vary (the level policy and the radii of influence).
+
+use bevy::prelude::*;
+use clap::ValueEnum;
+
+use super::GameSettings;
+use super::camera::FollowCamera;
+use super::player::{BaseConfig, NewRound, PlayerIntent};
+use super::scene::ColourByLevel;
+use crate::config::SimConfig;
+use crate::lod::LevelPolicy;
+
+/// The keys, as the HUD lists them.
+pub const CONTROLS: &str = "WASD / arrows steer   Enter new round   C colour by level   \
+L level policy   [ ] puck radius   - = camera radius   Esc quit";
+
+/// A short message on screen after a key press, with the time it goes away.
+#[derive(Resource, Debug, Default)]
+pub struct Notice {
+    pub text: String,
+    pub until_s: f32,
+}
+
+/// How long a notice stays.
+const NOTICE_S: f32 = 4.0;
+
+/// Steering keys, relative to the view: up is away from the camera.
+fn read_steering_keys(
+    keys: Res<ButtonInput<KeyCode>>,
+    camera: Query<&GlobalTransform, With<FollowCamera>>,
+    mut intent: ResMut<PlayerIntent>,
+) {
+    let pressed = |a: KeyCode, b: KeyCode| keys.pressed(a) || keys.pressed(b);
+    let mut ask = Vec2::ZERO;
+    ask.y += f32::from(u8::from(pressed(KeyCode::KeyW, KeyCode::ArrowUp)));
+    ask.y -= f32::from(u8::from(pressed(KeyCode::KeyS, KeyCode::ArrowDown)));
+    ask.x += f32::from(u8::from(pressed(KeyCode::KeyD, KeyCode::ArrowRight)));
+    ask.x -= f32::from(u8::from(pressed(KeyCode::KeyA, KeyCode::ArrowLeft)));
+    let (forward, right) = camera.single().map_or((Vec2::NEG_Y, Vec2::X), |t| {
+        let f = t.forward().as_vec3();
+        let f = Vec2::new(f.x, f.z).normalize_or(Vec2::NEG_Y);
+        (f, Vec2::new(-f.y, f.x))
+    });
+    let wanted = (forward * ask.y + right * ask.x).normalize_or_zero();
+    if intent.0 != wanted {
+        intent.0 = wanted;
+    }
+}
+
+fn read_game_keys(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time<Real>>,
+    mut rounds: MessageWriter<NewRound>,
+    mut exit: MessageWriter<AppExit>,
+    mut colour_by_level: ResMut<ColourByLevel>,
+    settings: Res<GameSettings>,
+    mut config: ResMut<SimConfig>,
+    mut base: ResMut<BaseConfig>,
+    mut notice: ResMut<Notice>,
+) {
+    let mut say = |text: String| {
+        *notice = Notice {
+            text,
+            until_s: time.elapsed_secs() + NOTICE_S,
+        }
+    };
+    if keys.just_pressed(KeyCode::Enter) {
+        rounds.write(NewRound);
+    }
+    if keys.just_pressed(KeyCode::Escape) {
+        exit.write(AppExit::Success);
+    }
+    if keys.just_pressed(KeyCode::KeyC) {
+        colour_by_level.0 = !colour_by_level.0;
+        say(format!(
+            "colour by level {}",
+            if colour_by_level.0 { "on" } else { "off" }
+        ));
+    }
+    if keys.just_pressed(KeyCode::KeyL) {
+        // Every policy there is, in turn. A policy picks each creature's level when it
+        // spawns, so a new round starts with it (and later rounds keep it).
+        let all = LevelPolicy::value_variants();
+        let now = all.iter().position(|&p| p == base.scenario.level_policy).unwrap_or(0);
+        let next = all[(now + 1) % all.len()];
+        base.scenario.level_policy = next;
+        rounds.write(NewRound);
+        say(format!("level policy {}: a new round", policy_name(next)));
+    }
+    // The puck's radius of influence (figure 8) and the camera's (figure 9), live: the
+    // rules decide levels at every decision, so the change shows at once (paper 3.4).
+    let step = settings.hud.radius_step_m;
+    for (key, which, by) in [
+        (KeyCode::BracketLeft, Radius::Puck, -step),
+        (KeyCode::BracketRight, Radius::Puck, step),
+        (KeyCode::Minus, Radius::Camera, -step),
+        (KeyCode::Equal, Radius::Camera, step),
+    ] {
+        if keys.just_pressed(key) {
+            let radius = (*which.of(&mut config) + by).max(0.0);
+            *which.of(&mut config) = radius;
+            *which.of(&mut base) = radius;
+            say(format!(
+                "{} radius of influence {radius:.0} m{}",
+                which.name(),
+                if which.used_by(config.scenario.level_policy) {
+                    String::new()
+                } else {
+                    format!(
+                        " (the {} policy does not use it)",
+                        policy_name(config.scenario.level_policy)
+                    )
+                }
+            ));
+        }
+    }
+}
+
+/// The radii of influence the keys change.
+#[derive(Clone, Copy)]
+enum Radius {
+    Puck,
+    Camera,
+}
+
+impl Radius {
+    fn of(self, config: &mut SimConfig) -> &mut f32 {
+        match self {
+            Radius::Puck => &mut config.rules.influence.puck_radius_m,
+            Radius::Camera => &mut config.rules.camera.radius_m,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Radius::Puck => "puck",
+            Radius::Camera => "camera",
+        }
+    }
+
+    fn used_by(self, policy: LevelPolicy) -> bool {
+        match self {
+            Radius::Puck => matches!(policy, LevelPolicy::Influence | LevelPolicy::Combined),
+            Radius::Camera => matches!(policy, LevelPolicy::Camera | LevelPolicy::Combined),
+        }
+    }
+}
+
+/// A policy as the command line spells it.
+pub fn policy_name(policy: LevelPolicy) -> String {
+    policy
+        .to_possible_value()
+        .map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<Notice>()
+        .add_systems(Update, (read_steering_keys, read_game_keys));
+}

@@ -1,0 +1,314 @@
+//! Drawing the creatures from their current model, coloured by level (paper figures 5, 6).
+//!
+//! A simulated creature has no transform; each gets a drawing of its own: a root entity
+//! with a body and its legs as children. Drawing is two steps. First, the draw system of
+//! each level writes the [`CreaturePose`] of the creatures at that level from what that
+//! model knows: the rigid level copies its rapier bodies; the hybrid and point-mass levels
+//! stand the body on the point mass in the [`GaitPose`] their model publishes (from the
+//! gait table, or the standing pose). Then [`apply_poses`] moves the meshes, whatever the
+//! level.
+
+use bevy::camera::visibility::RenderLayers;
+use bevy::prelude::*;
+
+use super::GameSettings;
+use super::player::Round;
+use super::scene::Palette;
+use crate::SimEntity;
+use crate::config::SimConfig;
+use crate::creature::{Creature, KindTable, PlanarState};
+use crate::gait::GaitPose;
+use crate::lod::Lod;
+use crate::models::rigid::{RigidHopper, RigidPart};
+
+/// Rapier's bodies face +x; a pose faces -z.
+const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
+    0.0,
+    std::f32::consts::FRAC_1_SQRT_2,
+    0.0,
+    std::f32::consts::FRAC_1_SQRT_2,
+);
+
+/// The two steps of drawing, in `Update`.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DrawCreatures {
+    /// Each level's draw system writes the poses of its creatures.
+    Pose,
+    /// The meshes follow the poses.
+    Apply,
+}
+
+/// The drawing of one simulated creature.
+#[derive(Component, Debug)]
+pub struct CreatureVisual {
+    pub creature: Entity,
+    body: Entity,
+    legs: Vec<Entity>,
+    /// Its dot in the overhead view.
+    dot: Entity,
+}
+
+/// The render layer only the overhead view sees: dots and the view cone.
+pub const OVERHEAD_ONLY: usize = 1;
+
+/// Where a creature's parts are this frame, in world space.
+#[derive(Component, Debug, Default, Clone, PartialEq)]
+pub struct CreaturePose {
+    /// The body's centre and orientation (`-z` forward).
+    pub body: Transform,
+    /// Body radius, for the body mesh's scale.
+    pub body_radius_m: f32,
+    /// Hip and foot of each leg.
+    pub legs: Vec<(Vec3, Vec3)>,
+    /// The level the pose was drawn from, for the body's colour.
+    pub level: Lod,
+}
+
+/// A unit sphere and a unit cylinder, scaled per part.
+#[derive(Resource)]
+struct PartMeshes {
+    sphere: Handle<Mesh>,
+    cylinder: Handle<Mesh>,
+    ring: Handle<Mesh>,
+    disc: Handle<Mesh>,
+}
+
+/// A ring on the ground under the player's creature, this many footprint radii across: a
+/// small one for the player's view, a big one for the overhead view.
+#[derive(Component)]
+struct PlayerMarker {
+    radii: f32,
+}
+
+fn spawn_visuals(
+    mut commands: Commands,
+    config: Res<SimConfig>,
+    settings: Res<GameSettings>,
+    meshes: Res<PartMeshes>,
+    palette: Res<Palette>,
+    creatures: Query<(Entity, &Creature, &Lod), Added<Creature>>,
+) {
+    for (entity, creature, lod) in &creatures {
+        let name = &config.kinds[creature.kind].name;
+        let leg_count = if settings.creature_look.two_legged_kinds.contains(name) {
+            2
+        } else {
+            1
+        };
+        let body = commands
+            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
+            .id();
+        let dot = commands
+            .spawn((
+                Mesh3d(meshes.disc.clone()),
+                MeshMaterial3d(palette.body(*lod)),
+                RenderLayers::layer(OVERHEAD_ONLY),
+            ))
+            .id();
+        let legs: Vec<Entity> = (0..leg_count)
+            .map(|_| {
+                commands
+                    .spawn((Mesh3d(meshes.cylinder.clone()), MeshMaterial3d(palette.leg.clone())))
+                    .id()
+            })
+            .collect();
+        commands
+            .spawn((
+                Name::new(format!("{name} {}", creature.serial)),
+                SimEntity,
+                Transform::default(),
+                Visibility::default(),
+                CreaturePose::default(),
+            ))
+            .add_children(&[body, dot])
+            .add_children(&legs)
+            .insert(CreatureVisual {
+                creature: entity,
+                body,
+                legs,
+                dot,
+            });
+    }
+}
+
+/// A creature removed by the simulation (it fell) takes its drawing with it.
+fn despawn_orphans(
+    mut commands: Commands,
+    visuals: Query<(Entity, &CreatureVisual)>,
+    creatures: Query<(), With<Creature>>,
+) {
+    for (visual, v) in &visuals {
+        if creatures.get(v.creature).is_err() {
+            commands.entity(visual).despawn();
+        }
+    }
+}
+
+/// The levels that move as a point mass and publish a [`GaitPose`]: the hybrid (paper 3.2)
+/// poses the body and leg from the gait table; the point mass (3.3) holds its kind's
+/// standing pose, the leg at a constant angle. The body stands where the point mass is,
+/// facing its heading; a two-legged kind has the leg on each side.
+fn pose_from_gait(
+    kinds: Res<KindTable>,
+    settings: Res<GameSettings>,
+    creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPose)>,
+    mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
+) {
+    for (visual, mut pose) in &mut visuals {
+        let Ok((creature, &level, state, gait)) = creatures.get(visual.creature) else {
+            continue;
+        };
+        if !level.moves_as_point_mass() {
+            continue;
+        }
+        let body_radius = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
+        // The inverse of `rigid_pose`: rapier's body frame (x forward, y up, z to the side),
+        // yawed to the heading, then pitched and rolled.
+        let yaw = -state.heading.y.atan2(state.heading.x);
+        let rotation = Quat::from_euler(EulerRot::YZX, yaw, gait.pitch_rad, gait.roll_rad);
+        let centre = Vec3::new(state.position.x, gait.body_height_m, state.position.y);
+        let leg = rotation
+            * Vec3::new(gait.leg_forward_rad.tan(), -1.0, -gait.leg_sideways_rad.tan()).normalize()
+            * gait.leg_length_m;
+        let side = rotation * Vec3::Z * body_radius * 0.5;
+        let hips: &[Vec3] = if visual.legs.len() == 2 {
+            &[centre - side, centre + side]
+        } else {
+            &[centre]
+        };
+        pose.body = Transform::from_translation(centre).with_rotation(rotation * RAPIER_TO_POSE);
+        pose.body_radius_m = body_radius;
+        pose.legs = hips.iter().map(|&hip| (hip, hip + leg)).collect();
+        pose.level = level;
+    }
+}
+
+/// The rigid level (paper 3.1): the body and the leg where rapier has them.
+fn pose_rigid_hoppers(
+    kinds: Res<KindTable>,
+    settings: Res<GameSettings>,
+    creatures: Query<(&Creature, &Lod, &RigidHopper)>,
+    parts: Query<&Transform, With<RigidPart>>,
+    mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
+) {
+    for (visual, mut pose) in &mut visuals {
+        let Ok((creature, &Lod::Rigid, hopper)) = creatures.get(visual.creature) else {
+            continue;
+        };
+        let (Ok(body), Ok(hip), Ok(foot)) = (
+            parts.get(hopper.body),
+            parts.get(hopper.upper_leg),
+            parts.get(hopper.lower_leg),
+        ) else {
+            continue;
+        };
+        pose.body = Transform::from_translation(body.translation).with_rotation(body.rotation * RAPIER_TO_POSE);
+        pose.body_radius_m = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
+        pose.legs = vec![(hip.translation, foot.translation)];
+        pose.level = Lod::Rigid;
+    }
+}
+
+/// Moves the meshes of every creature to its pose, and colours its body by its level.
+fn apply_poses(
+    settings: Res<GameSettings>,
+    palette: Res<Palette>,
+    mut roots: Query<(&CreatureVisual, &CreaturePose, &mut Transform)>,
+    mut parts: Query<(&mut Transform, Option<&mut MeshMaterial3d<StandardMaterial>>), Without<CreatureVisual>>,
+) {
+    let look = &settings.creature_look;
+    let thickness = look.leg_thickness_m;
+    let body_shape = Vec3::new(1.0, look.body_height_ratio, look.body_length_ratio);
+    let dot_radius = settings.inset.creature_dot_radius_m;
+    for (visual, pose, mut root) in &mut roots {
+        *root = pose.body;
+        let to_local = pose.body.to_matrix().inverse();
+        let level = palette.body(pose.level);
+        if let Ok((mut body, material)) = parts.get_mut(visual.body) {
+            *body = Transform::from_scale(body_shape * pose.body_radius_m);
+            if let Some(mut material) = material
+                && material.0 != level
+            {
+                material.0 = level.clone();
+            }
+        }
+        if let Ok((mut dot, material)) = parts.get_mut(visual.dot) {
+            let ground = to_local.transform_point3(pose.body.translation.with_y(0.05));
+            *dot = Transform::from_translation(ground).with_scale(Vec3::splat(dot_radius));
+            if let Some(mut material) = material
+                && material.0 != level
+            {
+                material.0 = level;
+            }
+        }
+        for (&leg, &(hip, foot)) in visual.legs.iter().zip(&pose.legs) {
+            if let Ok((mut transform, _)) = parts.get_mut(leg) {
+                let (hip, foot) = (to_local.transform_point3(hip), to_local.transform_point3(foot));
+                let along = foot - hip;
+                *transform = Transform::from_translation((hip + foot) / 2.0)
+                    .with_rotation(Quat::from_rotation_arc(Vec3::Y, along.normalize_or(Vec3::NEG_Y)))
+                    .with_scale(Vec3::new(thickness / 2.0, along.length(), thickness / 2.0));
+            }
+        }
+    }
+}
+
+/// Keeps the ring under the player's creature, hidden when there is none.
+fn mark_player(
+    round: Res<Round>,
+    kinds: Res<KindTable>,
+    creatures: Query<(&Creature, &PlanarState)>,
+    mut markers: Query<(&PlayerMarker, &mut Transform, &mut Visibility)>,
+) {
+    let player = round.player.and_then(|p| creatures.get(p).ok());
+    for (marker, mut transform, mut visibility) in &mut markers {
+        match player {
+            Some((creature, state)) => {
+                let r = kinds[creature.kind].radius_m * marker.radii;
+                *transform =
+                    Transform::from_xyz(state.position.x, 0.03, state.position.y).with_scale(Vec3::new(r, 1.0, r));
+                *visibility = Visibility::Inherited;
+            }
+            None => *visibility = Visibility::Hidden,
+        }
+    }
+}
+
+fn spawn_player_markers(mut commands: Commands, meshes: Res<PartMeshes>, palette: Res<Palette>) {
+    let marker = |radii| {
+        (
+            PlayerMarker { radii },
+            Mesh3d(meshes.ring.clone()),
+            MeshMaterial3d(palette.player_marker.clone()),
+            Visibility::Hidden,
+        )
+    };
+    commands.spawn((Name::new("player marker"), marker(1.8)));
+    commands.spawn((
+        Name::new("player marker, overhead"),
+        marker(5.0),
+        RenderLayers::layer(OVERHEAD_ONLY),
+    ));
+}
+
+pub(super) fn plugin(app: &mut App) {
+    let mut assets = app.world_mut().resource_mut::<Assets<Mesh>>();
+    let part_meshes = PartMeshes {
+        sphere: assets.add(Sphere::new(1.0)),
+        cylinder: assets.add(Cylinder::new(1.0, 1.0)),
+        ring: assets.add(Torus::new(0.85, 1.0)),
+        // Flat on the ground, facing up.
+        disc: assets.add(Mesh::from(Circle::new(1.0)).rotated_by(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2))),
+    };
+    app.insert_resource(part_meshes)
+        .configure_sets(Update, (DrawCreatures::Pose, DrawCreatures::Apply).chain())
+        .add_systems(Startup, spawn_player_markers)
+        .add_systems(
+            Update,
+            (
+                (despawn_orphans, spawn_visuals).chain().before(DrawCreatures::Pose),
+                (pose_from_gait, pose_rigid_hoppers).in_set(DrawCreatures::Pose),
+                (apply_poses, mark_player).in_set(DrawCreatures::Apply),
+            ),
+        );
+}

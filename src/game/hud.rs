@@ -1,0 +1,248 @@
+//! The HUD: the player's score, the frame rate and the simulation's cost per frame, the
+//! creatures at each level, collisions and falls, the level policy; the game-over banner;
+//! the keys; and any problem with an edited asset file.
+
+use bevy::app::RunFixedMainLoopSystems;
+use bevy::prelude::*;
+use std::fmt::Write;
+use std::time::Instant;
+
+use super::GameSettings;
+use super::controls::{CONTROLS, Notice, policy_name};
+use super::player::Round;
+use super::reload::Problems;
+use crate::config::SimConfig;
+use crate::outcome::{Summary, summarize};
+
+/// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
+#[derive(Resource, Debug, Default)]
+struct Timing {
+    ticks_started: Option<Instant>,
+    /// When the last frame's ticks ended: the frame rate is measured by the wall clock, even
+    /// when `--screenshot` sets the game's time per frame.
+    last_frame: Option<Instant>,
+    sim_ms_per_frame: f32,
+    frames_per_s: f32,
+}
+
+/// The world's counts, read once a frame.
+#[derive(Resource, Debug)]
+struct Counts(Summary);
+
+#[derive(Component, Clone, Copy, PartialEq, Eq)]
+enum HudText {
+    Stats,
+    Banner,
+    Problems,
+    Help,
+}
+
+fn start_timing(mut timing: ResMut<Timing>) {
+    timing.ticks_started = Some(Instant::now());
+}
+
+/// Measured around the fixed loop, outside the simulation: the simulation never reads the
+/// clock.
+fn stop_timing(settings: Res<GameSettings>, mut timing: ResMut<Timing>) {
+    let Some(start) = timing.ticks_started.take() else {
+        return;
+    };
+    let now = Instant::now();
+    let dt = timing
+        .last_frame
+        .replace(now)
+        .map_or(0.0, |last| (now - last).as_secs_f32());
+    let ease = 1.0 - (-dt / settings.hud.smoothing_s).exp();
+    let sim_ms = start.elapsed().as_secs_f32() * 1000.0;
+    timing.sim_ms_per_frame += (sim_ms - timing.sim_ms_per_frame) * ease;
+    if dt > 0.0 {
+        timing.frames_per_s += (1.0 / dt - timing.frames_per_s) * ease;
+    }
+}
+
+fn count(world: &mut World) {
+    let summary = summarize(world, 0.0);
+    world.insert_resource(Counts(summary));
+}
+
+fn panel() -> (BackgroundColor, TextColor) {
+    (
+        BackgroundColor(Color::srgba(0.0, 0.0, 0.0, 0.55)),
+        TextColor(Color::WHITE),
+    )
+}
+
+fn spawn_hud(mut commands: Commands, settings: Res<GameSettings>) {
+    let size = settings.hud.font_size_px;
+    let at = |top: Option<f32>, bottom: Option<f32>| Node {
+        position_type: PositionType::Absolute,
+        left: px(12),
+        top: top.map_or(Val::Auto, px),
+        bottom: bottom.map_or(Val::Auto, px),
+        padding: UiRect::axes(px(10), px(6)),
+        ..default()
+    };
+    commands.spawn((
+        HudText::Stats,
+        Text::default(),
+        TextFont::from_font_size(size),
+        at(Some(12.0), None),
+        panel(),
+    ));
+    commands.spawn((
+        HudText::Help,
+        Text::default(),
+        TextFont::from_font_size(size * 0.85),
+        at(None, Some(12.0)),
+        panel(),
+    ));
+    commands.spawn((
+        HudText::Problems,
+        Text::default(),
+        TextFont::from_font_size(size),
+        TextColor(Color::srgb(1.0, 0.85, 0.85)),
+        BackgroundColor(Color::srgba(0.55, 0.0, 0.0, 0.85)),
+        Node {
+            position_type: PositionType::Absolute,
+            left: px(12),
+            right: px(12),
+            bottom: px(60),
+            padding: UiRect::all(px(10)),
+            display: Display::None,
+            ..default()
+        },
+    ));
+    // The banner, centred.
+    commands
+        .spawn(Node {
+            width: percent(100),
+            height: percent(100),
+            position_type: PositionType::Absolute,
+            justify_content: JustifyContent::Center,
+            align_items: AlignItems::Center,
+            ..default()
+        })
+        .with_child((
+            HudText::Banner,
+            Text::default(),
+            TextFont::from_font_size(settings.hud.banner_font_size_px),
+            TextLayout::justify(Justify::Center),
+            Node {
+                padding: UiRect::all(px(24)),
+                display: Display::None,
+                ..default()
+            },
+            panel(),
+        ));
+}
+
+fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConfig) -> String {
+    let mut s = String::new();
+    let score = round.score.unwrap_or(super::player::Score {
+        survived_s: 0.0,
+        collisions: 0,
+    });
+    let _ = writeln!(
+        s,
+        "ESCAPE THE PUCK   round {}\nsurvived {:.1} s   your collisions {}",
+        round.number + 1,
+        score.survived_s,
+        score.collisions
+    );
+    let _ = writeln!(
+        s,
+        "{:.1} fps   simulation {:.2} ms/frame",
+        timing.frames_per_s, timing.sim_ms_per_frame
+    );
+    let levels: Vec<String> = counts.levels.iter().map(|(l, n)| format!("{l} {n}")).collect();
+    let _ = writeln!(s, "creatures: {}", levels.join(", "));
+    let hits: Vec<String> = counts.collisions.iter().map(|(o, n)| format!("{o} {n}")).collect();
+    let _ = writeln!(s, "collisions: {}   falls {}", hits.join(", "), counts.falls);
+    let rules = &config.rules;
+    let _ = write!(
+        s,
+        "level policy: {}   radius of influence: puck {:.0} m, camera {:.0} m",
+        policy_name(config.scenario.level_policy),
+        rules.influence.puck_radius_m,
+        rules.camera.radius_m
+    );
+    s
+}
+
+fn show_hud(
+    real: Res<Time<Real>>,
+    round: Res<Round>,
+    timing: Res<Timing>,
+    counts: Res<Counts>,
+    config: Res<SimConfig>,
+    problems: Res<Problems>,
+    notice: Res<Notice>,
+    mut texts: Query<(&HudText, &mut Text, &mut Node)>,
+) {
+    for (which, mut text, mut node) in &mut texts {
+        let (shown, wanted) = match which {
+            HudText::Stats => (true, stats_text(&round, &timing, &counts.0, &config)),
+            HudText::Help => {
+                let mut help = CONTROLS.to_owned();
+                if real.elapsed_secs() < notice.until_s {
+                    help = format!("{}\n{help}", notice.text);
+                }
+                (true, help)
+            }
+            HudText::Banner => {
+                let score = round.score.map_or(0.0, |s| s.survived_s);
+                let hits = round.score.map_or(0, |s| s.collisions);
+                (
+                    round.over,
+                    format!(
+                        "KNOCKED DOWN\nsurvived {score:.1} s with {hits} collision{}\npress Enter to play again",
+                        if hits == 1 { "" } else { "s" }
+                    ),
+                )
+            }
+            HudText::Problems => {
+                let lines: Vec<&str> = problems.0.values().map(String::as_str).collect();
+                (
+                    !lines.is_empty(),
+                    format!("{}\n(the game runs on with the last good values)", lines.join("\n")),
+                )
+            }
+        };
+        let display = if shown { Display::Flex } else { Display::None };
+        if node.display != display {
+            node.display = display;
+        }
+        if text.0 != wanted {
+            text.0 = wanted;
+        }
+    }
+}
+
+/// Font sizes follow `game.ron`.
+fn resize_fonts(settings: Res<GameSettings>, mut texts: Query<(&HudText, &mut TextFont)>) {
+    if !settings.is_changed() {
+        return;
+    }
+    let h = &settings.hud;
+    for (which, mut font) in &mut texts {
+        let size = match which {
+            HudText::Banner => h.banner_font_size_px,
+            HudText::Help => h.font_size_px * 0.85,
+            HudText::Stats | HudText::Problems => h.font_size_px,
+        };
+        font.font_size = size.into();
+    }
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<Timing>()
+        .add_systems(Startup, spawn_hud)
+        .add_systems(
+            RunFixedMainLoop,
+            (
+                start_timing.in_set(RunFixedMainLoopSystems::BeforeFixedMainLoop),
+                stop_timing.in_set(RunFixedMainLoopSystems::AfterFixedMainLoop),
+            ),
+        )
+        .add_systems(Update, (count, show_hud, resize_fonts).chain());
+}

@@ -1,0 +1,122 @@
+//! The game: the escape-the-puck world in a window (paper figures 1, 5 and 6). The player
+//! steers one creature; the camera follows it with the puck in view; an overhead inset
+//! shows the whole court; the HUD shows the frame rate, the simulation's cost and the
+//! levels of detail. Everything here only reads the simulation, except the player's
+//! desired velocity and starting the world over.
+
+mod camera;
+mod controls;
+mod creatures;
+mod hud;
+pub mod player;
+pub mod reload;
+mod scene;
+mod screenshot;
+
+use bevy::asset::AssetMetaCheck;
+use bevy::prelude::*;
+use bevy::window::WindowResolution;
+use std::path::{Path, PathBuf};
+
+use crate::SimPlugin;
+use crate::config::{GameConfig, SimConfig, load_file};
+use crate::lod::LevelPolicy;
+
+/// What `simlod play` was asked for.
+pub struct PlayOptions {
+    pub scenario: PathBuf,
+    pub assets: PathBuf,
+    /// Overrides the scenario's level policy.
+    pub policy: Option<LevelPolicy>,
+    /// Render this many frames, save a screenshot here and quit.
+    pub screenshot: Option<(PathBuf, u32)>,
+}
+
+/// The look of the game: the last good `assets/game.ron`.
+#[derive(Resource, Clone, Debug, Deref)]
+pub struct GameSettings(pub GameConfig);
+
+/// The file the game's looks are read from, under the assets folder.
+pub const GAME_FILE: &str = "game.ron";
+
+/// Said instead of a panic when there is no display to open a window on.
+pub const NO_DISPLAY: &str = "simlod cannot open the game window: no display is available (DISPLAY is not set or the X server cannot be reached); `simlod run` simulates without a window.";
+
+/// Opens the game window and plays until it closes.
+pub fn play(options: PlayOptions) -> Result<(), String> {
+    let mut config = SimConfig::load(&options.scenario, &options.assets).map_err(|e| e.to_string())?;
+    if let Some(policy) = options.policy {
+        config.scenario.level_policy = policy;
+    }
+    let looks: GameConfig = load_file(&options.assets.join(GAME_FILE)).map_err(|e| e.to_string())?;
+    let scenario_asset = asset_path(&options.assets, &options.scenario)?;
+    let mut app = App::new();
+    add_window_plugins(&mut app, &options)?;
+    app.add_plugins(SimPlugin { config })
+        .insert_resource(GameSettings(looks))
+        .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone()));
+    plugin(&mut app);
+    if let Some((path, frames)) = options.screenshot {
+        screenshot::plugin(&mut app, path, frames);
+    }
+    match app.run() {
+        AppExit::Success => Ok(()),
+        AppExit::Error(_) => Err("the game stopped with an error (see above)".to_owned()),
+    }
+}
+
+/// The scenario's path inside the assets folder, which is what the asset server watches.
+fn asset_path(assets: &Path, scenario: &Path) -> Result<String, String> {
+    let (Ok(root), Ok(file)) = (assets.canonicalize(), scenario.canonicalize()) else {
+        return Err(format!("cannot find {} or {}", scenario.display(), assets.display()));
+    };
+    let inside = file.strip_prefix(&root).map_err(|_| {
+        format!(
+            "the scenario {} must be inside the assets folder {} (or give --assets)",
+            scenario.display(),
+            assets.display()
+        )
+    })?;
+    Ok(inside.to_string_lossy().replace('\\', "/"))
+}
+
+/// Bevy's plugins for a window. Building the window's event loop panics when there is no
+/// display; that panic is caught and told in one sentence.
+fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), String> {
+    let plugins = DefaultPlugins
+        .set(WindowPlugin {
+            primary_window: Some(Window {
+                title: "simlod: escape the puck".to_owned(),
+                resolution: WindowResolution::new(1280, 720),
+                ..default()
+            }),
+            ..default()
+        })
+        .set(AssetPlugin {
+            // Bevy resolves a relative path against the executable's folder, not ours.
+            file_path: std::path::absolute(&options.assets)
+                .unwrap_or_else(|_| options.assets.clone())
+                .to_string_lossy()
+                .into_owned(),
+            watch_for_changes_override: Some(true),
+            meta_check: AssetMetaCheck::Never,
+            ..default()
+        });
+    let quiet = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let built = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        app.add_plugins(plugins);
+    }));
+    std::panic::set_hook(quiet);
+    built.map_err(|_| NO_DISPLAY.to_owned())
+}
+
+fn plugin(app: &mut App) {
+    player::plugin(app);
+    reload::plugin(app);
+    scene::plugin(app);
+    creatures::plugin(app);
+    camera::plugin(app);
+    controls::plugin(app);
+    hud::plugin(app);
+}

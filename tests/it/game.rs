@@ -1,0 +1,234 @@
+//! The game's parts that need no window: rounds and game over, hot reload keeping the last
+//! good values, the looks file, and the message when there is no display.
+
+use bevy::asset::AssetPlugin;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use crate::support::*;
+use simlod::SimPlugin;
+use simlod::arena::PuckState;
+use simlod::config::{GameConfig, SimConfig, load_file};
+use simlod::creature::PlanarState;
+use simlod::game::player::{NewRound, PlayerIntent, Round};
+use simlod::game::reload::{Problems, Watched};
+use simlod::headless::HeadlessSim;
+
+fn player_state(app: &mut App) -> Option<PlanarState> {
+    let player = app.world().resource::<Round>().player?;
+    app.world().get::<PlanarState>(player).copied()
+}
+
+#[test]
+fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
+    let mut sim = HeadlessSim::new(config_with_hoppers(10));
+    simlod::game::player::plugin(&mut sim.app);
+    sim.advance_frame();
+    let start = player_state(&mut sim.app).expect("a creature is the player's");
+    // Away from the puck, toward the court's centre line.
+    let wanted = Vec2::new(-start.position.x.signum(), 0.0);
+    sim.app.world_mut().resource_mut::<PlayerIntent>().0 = wanted;
+    for _ in 0..45 {
+        sim.advance_frame();
+    }
+    let moved = player_state(&mut sim.app).unwrap();
+    assert!(moved.velocity.normalize().dot(wanted) > 0.99, "{}", moved.velocity);
+    assert!(sim.app.world().resource::<Round>().score.unwrap().survived_s > 1.0);
+
+    // Put the player right in front of the puck: knocked down, the round is over.
+    let puck = *sim.app.world().resource::<PuckState>();
+    let player = sim.app.world().resource::<Round>().player.unwrap();
+    sim.app.world_mut().resource_mut::<PlayerIntent>().0 = Vec2::ZERO;
+    sim.app.world_mut().get_mut::<PlanarState>(player).unwrap().position =
+        puck.position + puck.velocity.normalize() * 3.0;
+    for _ in 0..30 {
+        sim.advance_frame();
+    }
+    let round = sim.app.world().resource::<Round>();
+    assert!(round.over, "the player's creature fell: game over");
+    assert!(sim.app.world().get_entity(player).is_err(), "the core removed it");
+    assert!(round.score.unwrap().collisions >= 1);
+
+    // A new round: a fresh world and a new creature to play.
+    sim.app.world_mut().write_message(NewRound);
+    sim.advance_frame();
+    let round = sim.app.world().resource::<Round>();
+    assert!(!round.over);
+    assert_eq!(round.number, 1);
+    assert!(round.player.is_some_and(|p| p != player));
+    assert!(sim.clock().seconds() < 0.1, "the world started over");
+}
+
+/// The game's rules and hot reload on a copy of the assets, without a window.
+fn watching_app(root: &Path) -> App {
+    let config = SimConfig::load(&root.join("scenarios/default.ron"), root).unwrap();
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin {
+            file_path: root.to_string_lossy().into_owned(),
+            watch_for_changes_override: Some(true),
+            ..default()
+        },
+    ))
+    .add_plugins(SimPlugin { config })
+    .insert_resource(Watched::new("scenarios/default.ron".to_owned(), root.to_path_buf()))
+    .insert_resource(TimeUpdateStrategy::FixedTimesteps(8));
+    simlod::game::player::plugin(&mut app);
+    simlod::game::reload::plugin(&mut app);
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Updates until `done` holds (file events take a moment to arrive).
+fn update_until(app: &mut App, what: &str, done: impl Fn(&mut App) -> bool) {
+    let start = Instant::now();
+    while !done(app) {
+        assert!(
+            start.elapsed() < Duration::from_secs(20),
+            "timed out waiting for {what}"
+        );
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+fn copy_assets(test: &str) -> std::path::PathBuf {
+    fn copy_dir(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).unwrap();
+        for entry in std::fs::read_dir(from).unwrap().flatten() {
+            let (path, target) = (entry.path(), to.join(entry.file_name()));
+            if path.is_dir() {
+                copy_dir(&path, &target);
+            } else {
+                std::fs::copy(&path, &target).unwrap();
+            }
+        }
+    }
+    let dir = scratch_dir(test);
+    copy_dir(&assets_root(), &dir);
+    dir
+}
+
+#[test]
+fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restarts_the_round() {
+    let root = copy_assets("hot_reload");
+    let mut app = watching_app(&root);
+    let puck_speed = |app: &mut App| app.world().resource::<SimConfig>().arena.puck.speed_m_per_s;
+    let seconds = |app: &mut App| app.world().resource::<simlod::SimClock>().seconds();
+    // Let the first loads settle.
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(app.world().resource::<Problems>().0.is_empty());
+    assert_eq!(app.world().resource::<Round>().number, 0);
+
+    let arena = std::fs::read_to_string(root.join("arena.ron")).unwrap();
+    std::fs::write(
+        root.join("arena.ron"),
+        arena.replacen("speed_m_per_s: 5.0", "speed_m_per_s: -5.0", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the bad edit's problem", |app| {
+        !app.world().resource::<Problems>().0.is_empty()
+    });
+    let problem = app.world().resource::<Problems>().0.values().next().unwrap().clone();
+    assert!(
+        problem.contains("puck.speed_m_per_s") && problem.contains("greater than 0"),
+        "{problem}"
+    );
+    let before = seconds(&mut app);
+    for _ in 0..5 {
+        app.update();
+    }
+    assert_eq!(puck_speed(&mut app), 5.0, "the last good value stays");
+    assert!(seconds(&mut app) > before, "the world runs on");
+    assert_eq!(app.world().resource::<Round>().number, 0);
+
+    std::fs::write(
+        root.join("arena.ron"),
+        arena.replacen("speed_m_per_s: 5.0", "speed_m_per_s: 6.5", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the good edit", |app| puck_speed(app) == 6.5);
+    assert!(app.world().resource::<Problems>().0.is_empty(), "the problem is gone");
+    assert_eq!(
+        app.world().resource::<Round>().number,
+        1,
+        "a new round with the edited file"
+    );
+    assert!(seconds(&mut app) < 1.0, "the world started over");
+}
+
+#[test]
+fn the_shipped_game_file_loads_and_a_bad_colour_is_named() {
+    let looks: GameConfig = load_file(&assets_root().join("game.ron")).expect("game.ron loads");
+    assert!(looks.inset.width_fraction > 0.0);
+    let text = std::fs::read_to_string(assets_root().join("game.ron")).unwrap();
+    let dir = scratch_dir("bad_game_file");
+    let bad = dir.join("game.ron");
+    std::fs::write(&bad, text.replacen("PointMass: (0.93,", "PointMass: (1.93,", 1)).unwrap();
+    let err = load_file::<GameConfig>(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("`level_colours_srgb.PointMass.0`") && err.contains("between 0 and 1"),
+        "{err}"
+    );
+}
+
+#[test]
+fn without_a_display_the_game_says_so_in_one_sentence_and_points_to_run() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_simlod"))
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env("RUST_LOG", "off")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("no display") && stderr.contains("simlod run"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn an_edited_gait_table_is_watched_like_the_other_files() {
+    let root = copy_assets("hot_reload_gait");
+    let mut app = watching_app(&root);
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let file = root.join("gaits/hopper.ron");
+    let table = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: -1.0", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the bad gait table's problem", |app| {
+        app.world()
+            .resource::<Problems>()
+            .0
+            .values()
+            .any(|p| p.contains("top_speed_m_per_s"))
+    });
+    assert_eq!(app.world().resource::<Round>().number, 0);
+    std::fs::write(
+        &file,
+        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: 2.5", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the good gait table", |app| {
+        app.world().resource::<Round>().number == 1
+    });
+    let config = app.world().resource::<SimConfig>();
+    assert_eq!(config.gaits[0].as_ref().unwrap().top_speed_m_per_s, 2.5);
+    assert!(app.world().resource::<Problems>().0.is_empty());
+}
