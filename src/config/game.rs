@@ -51,8 +51,8 @@ pub struct InsetConfig {
     pub border_m: f32,
     /// Creatures are tiny seen from above: each gets a dot this big, seen only from above.
     pub creature_dot_radius_m: f32,
-    /// The player's view, drawn from above as a fan (paper figure 6, top).
-    pub view_cone_length_m: f32,
+    /// The player's view, drawn from above as a fan out to the camera's radius of influence
+    /// (paper figure 6, top).
     pub view_cone_opacity: f32,
 }
 
@@ -136,7 +136,6 @@ impl Validate for GameConfig {
             v.within("margin_px", i.margin_px, 0.0, 200.0);
             v.non_negative("border_m", i.border_m);
             v.positive("creature_dot_radius_m", i.creature_dot_radius_m);
-            v.positive("view_cone_length_m", i.view_cone_length_m);
             v.within("view_cone_opacity", i.view_cone_opacity, 0.0, 1.0);
         });
         v.nested("level_colours_srgb", |v| {

@@ -282,7 +282,7 @@ fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResM
         let level = config.scenario.level_policy.initial_level(&kinds[kind].levels);
         for _ in 0..group.count {
             // The puck starts at the centre.
-            let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {
+            let spot = find_free_spot(&mut rng, half, radius + clear, radius + clear, |p| {
                 placed.clearance(p).min(p.length() - puck_keep_out)
             });
             placed.insert(spot, radius);

@@ -12,7 +12,9 @@ use super::creatures::OVERHEAD_ONLY;
 use super::player::Round;
 use super::scene::srgb;
 use crate::arena::{Court, PuckState};
+use crate::config::SimConfig;
 use crate::creature::PlanarState;
+use crate::lod::{CameraFromView, SimCamera};
 
 /// The player's view. The HUD is drawn on it.
 #[derive(Component)]
@@ -156,9 +158,37 @@ fn place_overhead(
     frame.height = px(extent.y / scale + 2.0 * border);
 }
 
-/// Lays the fan on the ground under the follow camera, pointing where it looks.
+/// The camera rule (paper figure 6) sees what the player sees: the follow camera's place,
+/// direction and horizontal opening on the ground.
+fn share_view(
+    settings: Res<GameSettings>,
+    round: Res<Round>,
+    window: Single<&Window, With<PrimaryWindow>>,
+    camera: Single<&Transform, With<FollowCamera>>,
+    mut view: ResMut<SimCamera>,
+) {
+    let forward = camera.forward().as_vec3();
+    let shared = SimCamera {
+        position: camera.translation.xz(),
+        facing: forward.xz().normalize_or(Vec2::NEG_Y),
+        half_view_rad: horizontal_half_view(&settings, &window),
+        following: round.player,
+    };
+    view.set_if_neq(shared);
+}
+
+/// The horizontal half angle of the view, from the vertical field of view and the window.
+fn horizontal_half_view(settings: &GameSettings, window: &Window) -> f32 {
+    let aspect = window.width() / window.height().max(1.0);
+    ((settings.camera.field_of_view_deg.to_radians() / 2.0).tan() * aspect).atan()
+}
+
+/// Lays the fan on the ground under the follow camera, pointing where it looks, as long as
+/// the camera's radius of influence: the creatures inside it are the rigid ones of the
+/// camera rule.
 fn draw_view_cone(
     settings: Res<GameSettings>,
+    config: Res<SimConfig>,
     window: Single<&Window, With<PrimaryWindow>>,
     camera: Single<&Transform, With<FollowCamera>>,
     mut cone: Single<
@@ -175,10 +205,8 @@ fn draw_view_cone(
 ) {
     let inset = &settings.inset;
     let (cone, mesh, material, transform) = &mut *cone;
-    // The horizontal half angle of the view, from the vertical field of view and the window.
-    let aspect = window.width() / window.height().max(1.0);
-    let half = ((settings.camera.field_of_view_deg.to_radians() / 2.0).tan() * aspect).atan();
-    let shape = (inset.view_cone_length_m, half);
+    let half = horizontal_half_view(&settings, &window);
+    let shape = (config.rules.camera.radius_m, half);
     if cone.shape != shape {
         cone.shape = shape;
         // The sector points along +y in its plane; laid flat, along -z, the view's forward.
@@ -199,5 +227,9 @@ fn draw_view_cone(
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<FollowTarget>()
         .add_systems(Startup, spawn_cameras)
-        .add_systems(Update, (follow_player, place_overhead, draw_view_cone).chain());
+        .init_resource::<CameraFromView>()
+        .add_systems(
+            Update,
+            (follow_player, share_view, place_overhead, draw_view_cone).chain(),
+        );
 }

@@ -158,3 +158,76 @@ pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Notice>()
         .add_systems(Update, (read_steering_keys, read_game_keys));
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::load_file;
+    use crate::{SimPlugin, lod::LevelPolicy};
+    use std::path::Path;
+
+    fn app_with_keys(policy: LevelPolicy) -> App {
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let mut config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
+        config.scenario.level_policy = policy;
+        let looks = load_file(&root.join(crate::game::GAME_FILE)).unwrap();
+        let mut app = App::new();
+        app.add_plugins(MinimalPlugins)
+            .add_plugins(SimPlugin { config })
+            .init_resource::<ButtonInput<KeyCode>>()
+            .insert_resource(ColourByLevel(true))
+            .insert_resource(GameSettings(looks));
+        super::super::player::plugin(&mut app);
+        plugin(&mut app);
+        app.update();
+        app
+    }
+
+    fn press(app: &mut App, key: KeyCode) {
+        let mut keys = app.world_mut().resource_mut::<ButtonInput<KeyCode>>();
+        keys.release_all();
+        keys.clear();
+        keys.press(key);
+        app.update();
+    }
+
+    #[test]
+    fn radius_keys_change_the_running_rules_and_the_next_rounds() {
+        let mut app = app_with_keys(LevelPolicy::Combined);
+        let radii = |app: &App, of: fn(&SimConfig) -> f32| {
+            (
+                of(app.world().resource::<SimConfig>()),
+                of(app.world().resource::<BaseConfig>()),
+            )
+        };
+        let puck = |c: &SimConfig| c.rules.influence.puck_radius_m;
+        let camera = |c: &SimConfig| c.rules.camera.radius_m;
+        let (puck_before, camera_before) = (radii(&app, puck).0, radii(&app, camera).0);
+        press(&mut app, KeyCode::BracketRight);
+        press(&mut app, KeyCode::BracketRight);
+        press(&mut app, KeyCode::Minus);
+        assert_eq!(radii(&app, puck), (puck_before + 2.0, puck_before + 2.0));
+        assert_eq!(radii(&app, camera), (camera_before - 1.0, camera_before - 1.0));
+        for _ in 0..40 {
+            press(&mut app, KeyCode::BracketLeft);
+        }
+        assert_eq!(radii(&app, puck).0, 0.0, "a radius stops at zero");
+        assert!(
+            app.world()
+                .resource::<Notice>()
+                .text
+                .contains("puck radius of influence 0 m")
+        );
+    }
+
+    #[test]
+    fn a_radius_key_says_when_the_policy_does_not_use_that_radius() {
+        let mut app = app_with_keys(LevelPolicy::Camera);
+        press(&mut app, KeyCode::BracketRight);
+        let notice = &app.world().resource::<Notice>().text;
+        assert!(notice.contains("does not use it"), "{notice}");
+        press(&mut app, KeyCode::Equal);
+        let notice = &app.world().resource::<Notice>().text;
+        assert!(!notice.contains("does not use it"), "{notice}");
+    }
+}

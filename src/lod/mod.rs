@@ -7,7 +7,7 @@
 mod select;
 mod switch;
 
-pub use select::{LevelChoice, SimCamera, in_influence};
+pub use select::{CameraFromView, LevelChoice, SimCamera, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 
 use bevy::prelude::*;

@@ -35,15 +35,23 @@ pub struct LevelChoice {
     pub last_switch_s: f32,
 }
 
-/// The headless camera of the camera rule, on the ground plane.
+/// The camera of the camera rule, on the ground plane. Headless it follows a creature
+/// (figure 9's set-up); a window's camera sets it itself (see [`CameraFromView`]).
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimCamera {
     pub position: Vec2,
     /// Unit view direction.
     pub facing: Vec2,
+    /// Half the opening angle of the view on the ground plane.
+    pub half_view_rad: f32,
     /// The creature it follows.
     pub following: Option<Entity>,
 }
+
+/// Present when a window's camera writes [`SimCamera`] (the game): the camera rule then
+/// uses what the player sees, and the headless placement stands aside.
+#[derive(Resource, Debug, Default)]
+pub struct CameraFromView;
 
 /// Whether `q` lies in the stretched circle of a body at `p` moving at `v`.
 pub fn in_influence(q: Vec2, p: Vec2, v: Vec2, radius: f32, lookahead_s: f32) -> bool {
@@ -83,7 +91,7 @@ struct LevelInputs<'a> {
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
     reach_m: f32,
-    half_fov_cos: f32,
+    half_view_cos: f32,
 }
 
 impl LevelInputs<'_> {
@@ -113,7 +121,7 @@ impl LevelInputs<'_> {
     fn camera_level(&self, s: &PlanarState, r: &Radii) -> Lod {
         let to = s.position - self.camera.position;
         let distance = to.length();
-        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.half_fov_cos;
+        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.half_view_cos;
         match (in_view, distance <= r.camera) {
             (false, _) => Lod::PointMass,
             (true, false) => Lod::Hybrid,
@@ -155,6 +163,7 @@ fn place_camera(
     *camera = SimCamera {
         position: state.position - facing * config.rules.camera.follow_distance_m,
         facing,
+        half_view_rad: config.rules.camera.field_of_view_deg.to_radians() / 2.0,
         following: Some(entity),
     };
 }
@@ -183,7 +192,7 @@ fn select_levels(
         grid: &grid,
         camera: &camera,
         reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
-        half_fov_cos: (rules.camera.field_of_view_deg.to_radians() / 2.0).cos(),
+        half_view_cos: camera.half_view_rad.cos(),
     };
     let (enter, leave) = (Radii::of(rules, 0.0), Radii::of(rules, rules.release_margin_m));
     let now = clock.seconds() as f32;
@@ -218,7 +227,10 @@ fn select_levels(
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<SimCamera>().add_systems(
         FixedUpdate,
-        (place_camera, select_levels)
+        (
+            place_camera.run_if(not(resource_exists::<CameraFromView>)),
+            select_levels,
+        )
             .chain()
             .in_set(SimStage::SelectLod)
             .run_if(dynamic_policy),

@@ -15,11 +15,12 @@ use crate::{SimClock, SimStage};
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
 
-/// One tick of the planar point mass: velocity moves toward the desired one by at most the
-/// acceleration limit, then is clipped to the top speed.
+/// One tick of the planar point mass: velocity moves toward the desired one, clipped to the
+/// top speed, by at most the acceleration limit. A body faster than its top speed (shoved,
+/// or just switched from the rigid level) slows at the limit: no pop in velocity.
 pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt: f32) {
-    let dv = (desired - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
-    state.velocity = (state.velocity + dv).clamp_length_max(kind.top_speed_m_per_s);
+    let target = desired.clamp_length_max(kind.top_speed_m_per_s);
+    state.velocity += (target - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
     state.position += state.velocity * dt;
     let speed = state.velocity.length();
     if speed > HEADING_MIN_SPEED_M_PER_S {
@@ -143,6 +144,24 @@ mod tests {
         }
         assert!((s.velocity.length() - 3.0).abs() < 1e-4);
         assert_eq!(s.heading, Vec2::X);
+    }
+
+    #[test]
+    fn a_body_faster_than_its_top_speed_slows_at_the_acceleration_limit() {
+        let k = kind();
+        let mut s = PlanarState {
+            velocity: Vec2::new(4.0, 0.0),
+            ..default()
+        };
+        let dt = 1.0 / 240.0;
+        for _ in 0..120 {
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+        }
+        assert!(
+            (s.velocity.x - 3.0).abs() < 1e-3,
+            "after 0.5 s at 2 m/s^2: {}",
+            s.velocity.x
+        );
     }
 
     #[test]

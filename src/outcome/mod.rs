@@ -234,7 +234,7 @@ fn respawn_fallen(
         tally.falls += 1;
         tally.respawns += 1;
         let radius = config.kinds[creature.kind].body.radius_m;
-        let spot = find_free_spot(&mut rng, half, radius, radius + clear, |p| {
+        let spot = find_free_spot(&mut rng, half, radius + clear, radius + clear, |p| {
             grid.clearance(p, radius + clear)
                 .min(p.distance(puck.position) - puck_keep_out)
         });

@@ -15,6 +15,7 @@ use simlod::creature::PlanarState;
 use simlod::game::player::{NewRound, PlayerIntent, Round};
 use simlod::game::reload::{Problems, Watched};
 use simlod::headless::HeadlessSim;
+use simlod::lod::LevelPolicy;
 
 fn player_state(app: &mut App) -> Option<PlanarState> {
     let player = app.world().resource::<Round>().player?;
@@ -23,7 +24,10 @@ fn player_state(app: &mut App) -> Option<PlanarState> {
 
 #[test]
 fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
-    let mut sim = HeadlessSim::new(config_with_hoppers(10));
+    // At the point-mass level, whose position the test sets directly below.
+    let mut config = config_with_hoppers(10);
+    config.scenario.level_policy = LevelPolicy::AllPointMass;
+    let mut sim = HeadlessSim::new(config);
     simlod::game::player::plugin(&mut sim.app);
     sim.advance_frame();
     let start = player_state(&mut sim.app).expect("a creature is the player's");
@@ -207,11 +211,11 @@ fn an_edited_gait_table_is_watched_like_the_other_files() {
     }
     let file = root.join("gaits/hopper.ron");
     let table = std::fs::read_to_string(&file).unwrap();
-    std::fs::write(
-        &file,
-        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: -1.0", 1),
-    )
-    .unwrap();
+    let with_top_speed = |v: &str| {
+        let line = table.lines().find(|l| l.contains("top_speed_m_per_s:")).unwrap();
+        table.replacen(line, &format!("    top_speed_m_per_s: {v},"), 1)
+    };
+    std::fs::write(&file, with_top_speed("-1.0")).unwrap();
     update_until(&mut app, "the bad gait table's problem", |app| {
         app.world()
             .resource::<Problems>()
@@ -220,15 +224,42 @@ fn an_edited_gait_table_is_watched_like_the_other_files() {
             .any(|p| p.contains("top_speed_m_per_s"))
     });
     assert_eq!(app.world().resource::<Round>().number, 0);
-    std::fs::write(
-        &file,
-        table.replacen("top_speed_m_per_s: 2.744483", "top_speed_m_per_s: 2.5", 1),
-    )
-    .unwrap();
+    std::fs::write(&file, with_top_speed("2.5")).unwrap();
     update_until(&mut app, "the good gait table", |app| {
         app.world().resource::<Round>().number == 1
     });
     let config = app.world().resource::<SimConfig>();
     assert_eq!(config.gaits[0].as_ref().unwrap().top_speed_m_per_s, 2.5);
     assert!(app.world().resource::<Problems>().0.is_empty());
+}
+
+#[test]
+fn an_edited_rules_file_applies_to_the_running_round_and_a_bad_one_is_named() {
+    let root = copy_assets("hot_reload_rules");
+    let mut app = watching_app(&root);
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let puck_radius = |app: &mut App| app.world().resource::<SimConfig>().rules.influence.puck_radius_m;
+    assert_eq!(puck_radius(&mut app), 10.0);
+    let file = root.join("rules/levels.ron");
+    let rules = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(
+        &file,
+        rules.replacen("flight_window: (0.1, 0.5)", "flight_window: (0.5, 0.1)", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the bad rules' problem", |app| {
+        app.world()
+            .resource::<Problems>()
+            .0
+            .values()
+            .any(|p| p.contains("flight_window"))
+    });
+    std::fs::write(&file, rules.replacen("puck_radius_m: 10.0", "puck_radius_m: 4.0", 1)).unwrap();
+    update_until(&mut app, "the good rules", |app| puck_radius(app) == 4.0);
+    assert!(app.world().resource::<Problems>().0.is_empty());
+    assert_eq!(app.world().resource::<Round>().number, 0, "the round runs on");
+    assert!(app.world().resource::<simlod::SimClock>().seconds() > 1.0);
 }

@@ -3,6 +3,7 @@
 use crate::support::*;
 use simlod::arena::PuckState;
 use simlod::headless::HeadlessSim;
+use simlod::lod::LevelPolicy;
 
 #[test]
 fn respawning_keeps_the_creature_count_constant() {
@@ -43,6 +44,9 @@ fn respawning_keeps_the_creature_count_constant() {
 fn a_creature_in_the_pucks_path_is_hit_and_counted() {
     // One creature standing still right in front of the puck, steering off.
     let mut config = config_with_hoppers(1);
+    // At the point-mass level, whose position the test sets directly (a rigid creature's
+    // bodies would stay where they were).
+    config.scenario.level_policy = LevelPolicy::AllPointMass;
     config.kinds[0].steering.cruise_speed_m_per_s = 0.0;
     config.kinds[0].steering.puck_weight = 0.0;
     config.kinds[0].steering.wall_weight = 0.0;

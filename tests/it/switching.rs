@@ -105,7 +105,13 @@ fn at_a_switch_the_body_does_not_jump() {
         // In flight the planar velocity of a hopper is nearly constant; within a hop the
         // rigid body's planar speed varies by about 0.2 m/s, so more than 0.3 m/s is a pop.
         let kick = o.after.velocity.distance(o.before.velocity);
-        assert!(kick < 0.3, "{:?}: velocity changed by {kick} m/s", o.switch);
+        assert!(
+            kick < 0.3,
+            "{:?}: velocity changed by {kick} m/s: {:?} {:?}",
+            o.switch,
+            o.before,
+            o.after
+        );
     }
 }
 
