@@ -12,7 +12,7 @@ use crate::outcome::CollisionRecord;
 use crate::{SimClock, SimStage, start_over};
 
 /// The config each new round starts from: the files' last good values, with the player's
-/// live tuning (the level policy).
+/// live tuning (the level policy, the radii of influence).
 #[derive(Resource, Clone, Debug, Deref, DerefMut)]
 pub struct BaseConfig(pub SimConfig);
 

@@ -1,8 +1,9 @@
 //! Hot reload: the scenario, arena, rules, creature, gait-table and game files load through
 //! Bevy's asset server, which watches them. A good edit of a simulation file starts a new
 //! round from the edited files; a good edit of the level rules or of `game.ron` applies at
-//! once, in the running round. A bad edit is shown
-//! on screen and everything runs on with the last good values.
+//! once, in the running round. A bad edit is shown on screen and everything runs on with the
+//! last good values. The player's live tuning (level policy, radii of influence) survives
+//! every reload except, for the radii, an edit of the rules file itself.
 
 use bevy::asset::{AssetLoadError, AssetLoadFailedEvent, AssetPath, UntypedAssetId};
 use bevy::prelude::*;
@@ -31,6 +32,8 @@ pub struct Watched {
     gaits: HashMap<String, Handle<GaitTable>>,
     game: Handle<GameConfig>,
     changed: bool,
+    /// The level rules as the files last said: the player's radii stand until they change.
+    file_rules: Option<LevelRules>,
 }
 
 impl Watched {
@@ -45,6 +48,7 @@ impl Watched {
             gaits: default(),
             game: default(),
             changed: false,
+            file_rules: None,
         }
     }
 
@@ -71,6 +75,7 @@ const ACROSS_FILES: &str = "";
 fn watch_files(server: Res<AssetServer>, base: Res<BaseConfig>, mut watched: ResMut<Watched>) {
     watched.scenario = server.load(watched.scenario_file.clone());
     watched.game = server.load(GAME_FILE);
+    watched.file_rules = Some(base.rules.clone());
     watched.arena = server.load(base.scenario.arena.clone());
     watched.rules = server.load(base.scenario.level_rules.clone());
     for kind in &base.kinds {
@@ -192,7 +197,8 @@ fn assemble(
 }
 
 /// After a change: a new round when the simulation files now say something else; new level
-/// rules apply to the running round (they decide levels from now on, paper 3.4).
+/// rules apply to the running round (they decide levels from now on, paper 3.4). Any other
+/// change (`game.ron`, say) keeps the rules the player tuned with the keys.
 fn apply_changes(
     server: Res<AssetServer>,
     scenarios: Res<Assets<Scenario>>,
@@ -215,16 +221,20 @@ fn apply_changes(
             problems.0.remove(ACROSS_FILES);
             // The level policy is the player's (`--policy`, the L key), not the file's.
             config.scenario.level_policy = base.scenario.level_policy;
+            let rules_edited = watched.file_rules.as_ref() != Some(&config.rules);
+            if rules_edited {
+                watched.file_rules = Some(config.rules.clone());
+                live.rules = config.rules.clone();
+            } else {
+                config.rules = base.rules.clone();
+            }
             let same = config.scenario == base.scenario
                 && config.arena == base.arena
                 && config.kinds == base.kinds
                 && config.gaits == base.gaits;
+            base.0 = config;
             if !same {
-                base.0 = config;
                 rounds.write(NewRound);
-            } else if config.rules != base.rules {
-                live.rules = config.rules.clone();
-                base.rules = config.rules;
             }
         }
         Err(e) => {

@@ -12,7 +12,8 @@ use simlod::SimPlugin;
 use simlod::arena::PuckState;
 use simlod::config::{GameConfig, SimConfig, load_file};
 use simlod::creature::PlanarState;
-use simlod::game::player::{NewRound, PlayerIntent, Round};
+use simlod::game::GameSettings;
+use simlod::game::player::{BaseConfig, NewRound, PlayerIntent, Round};
 use simlod::game::reload::{Problems, Watched};
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
@@ -262,4 +263,54 @@ fn an_edited_rules_file_applies_to_the_running_round_and_a_bad_one_is_named() {
     assert!(app.world().resource::<Problems>().0.is_empty());
     assert_eq!(app.world().resource::<Round>().number, 0, "the round runs on");
     assert!(app.world().resource::<simlod::SimClock>().seconds() > 1.0);
+}
+
+#[test]
+fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
+    let root = copy_assets("hot_reload_keeps_radii");
+    let mut app = watching_app(&root);
+    let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
+    app.insert_resource(GameSettings(looks.clone()));
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    // As the radius keys do: the running rules and the next rounds'.
+    let mut tuned = app.world().resource::<SimConfig>().rules.clone();
+    tuned.influence.puck_radius_m = 13.0;
+    tuned.camera.radius_m = 7.0;
+    app.world_mut().resource_mut::<SimConfig>().rules = tuned.clone();
+    app.world_mut().resource_mut::<BaseConfig>().rules = tuned;
+    let radii = |app: &mut App| {
+        [
+            app.world().resource::<SimConfig>(),
+            &app.world().resource::<BaseConfig>().0,
+        ]
+        .map(|c| (c.rules.influence.puck_radius_m, c.rules.camera.radius_m))
+    };
+
+    let file = root.join("game.ron");
+    let text = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, text.replacen("sky_srgb: (0.", "sky_srgb: (0.0", 1)).unwrap();
+    update_until(&mut app, "the looks edit", |app| {
+        app.world().resource::<GameSettings>().0 != looks
+    });
+    assert_eq!(
+        radii(&mut app),
+        [(13.0, 7.0); 2],
+        "a looks edit keeps the player's radii"
+    );
+
+    let file = root.join("rules/levels.ron");
+    let rules = std::fs::read_to_string(&file).unwrap();
+    std::fs::write(&file, rules.replacen("min_dwell_s: 0.5", "min_dwell_s: 0.4", 1)).unwrap();
+    update_until(&mut app, "the rules edit", |app| {
+        app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
+    });
+    assert_eq!(
+        radii(&mut app),
+        [(10.0, 12.0); 2],
+        "a rules edit puts back the file's radii"
+    );
+    assert_eq!(app.world().resource::<Round>().number, 0, "the round runs on");
 }
