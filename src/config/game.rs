@@ -19,6 +19,7 @@ pub struct GameConfig {
     /// every level needs one.
     pub level_colours_srgb: BTreeMap<Lod, Srgb>,
     pub scene_colours: SceneColours,
+    pub puck_look: PuckLook,
     pub lighting: LightingConfig,
     pub hud: HudConfig,
     pub creature_look: CreatureLook,
@@ -34,6 +35,9 @@ pub struct CameraConfig {
     pub follow_height_m: f32,
     /// Where the camera aims: 0 at the player, 1 at the puck.
     pub aim_toward_puck_fraction: f32,
+    /// Height of the point aimed at; below the ice (negative) tilts the view down, so the
+    /// court fills more of it and the sky less.
+    pub aim_height_m: f32,
     /// How fast the camera catches up with where it wants to be (per second).
     pub follow_rate_per_s: f32,
     pub field_of_view_deg: f32,
@@ -69,6 +73,16 @@ pub struct SceneColours {
     pub uncoloured_srgb: Srgb,
     /// The ring under the player's creature.
     pub player_marker_srgb: Srgb,
+}
+
+/// The puck, drawn to read as the threat: its colour is `scene_colours.puck_srgb`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PuckLook {
+    /// A wedge on the ice ahead of the puck points where it goes; its tip is where the puck's
+    /// front will be this long from now (0 hides it).
+    pub path_ahead_s: f32,
+    pub path_opacity: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -108,6 +122,9 @@ pub struct CreatureLook {
     pub body_length_ratio: f32,
     pub body_height_ratio: f32,
     pub leg_thickness_m: f32,
+    /// A nose at the front of the body shows which way a creature faces: its radius as a
+    /// share of the body's.
+    pub nose_radius_fraction: f32,
     /// Kinds drawn with two legs (the biped); the others have one.
     pub two_legged_kinds: Vec<String>,
 }
@@ -127,6 +144,7 @@ impl Validate for GameConfig {
             v.positive("follow_distance_m", c.follow_distance_m);
             v.positive("follow_height_m", c.follow_height_m);
             v.within("aim_toward_puck_fraction", c.aim_toward_puck_fraction, 0.0, 1.0);
+            v.within("aim_height_m", c.aim_height_m, -20.0, 20.0);
             v.positive("follow_rate_per_s", c.follow_rate_per_s);
             v.within("field_of_view_deg", c.field_of_view_deg, 10.0, 150.0);
         });
@@ -161,6 +179,11 @@ impl Validate for GameConfig {
                 colour(v, field, c);
             }
         });
+        let p = &self.puck_look;
+        v.nested("puck_look", |v| {
+            v.within("path_ahead_s", p.path_ahead_s, 0.0, 10.0);
+            v.within("path_opacity", p.path_opacity, 0.0, 1.0);
+        });
         let l = &self.lighting;
         v.nested("lighting", |v| {
             v.non_negative("sun_illuminance_lux", l.sun_illuminance_lux);
@@ -182,6 +205,7 @@ impl Validate for GameConfig {
             v.within("body_length_ratio", k.body_length_ratio, 0.2, 5.0);
             v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
             v.positive("leg_thickness_m", k.leg_thickness_m);
+            v.within("nose_radius_fraction", k.nose_radius_fraction, 0.05, 1.0);
         });
     }
 }

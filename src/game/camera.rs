@@ -104,7 +104,10 @@ fn follow_player(
     let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
     let away = (target.player - puck.position).normalize_or(Vec2::Y);
     let eye = at(target.player + away * c.follow_distance_m, c.follow_height_m);
-    let aim = at(target.player.lerp(puck.position, c.aim_toward_puck_fraction), 0.5);
+    let aim = at(
+        target.player.lerp(puck.position, c.aim_toward_puck_fraction),
+        c.aim_height_m,
+    );
     let ease = if target.placed {
         1.0 - (-c.follow_rate_per_s * time.delta_secs()).exp()
     } else {

@@ -43,6 +43,8 @@ pub enum DrawCreatures {
 pub struct CreatureVisual {
     pub creature: Entity,
     body: Entity,
+    /// At the front of the body: which way the creature faces.
+    nose: Entity,
     legs: Vec<Entity>,
     /// Its dot in the overhead view.
     dot: Entity,
@@ -98,6 +100,9 @@ fn spawn_visuals(
         let body = commands
             .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
             .id();
+        let nose = commands
+            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.leg.clone())))
+            .id();
         let dot = commands
             .spawn((
                 Mesh3d(meshes.disc.clone()),
@@ -120,11 +125,12 @@ fn spawn_visuals(
                 Visibility::default(),
                 CreaturePose::default(),
             ))
-            .add_children(&[body, dot])
+            .add_children(&[body, nose, dot])
             .add_children(&legs)
             .insert(CreatureVisual {
                 creature: entity,
                 body,
+                nose,
                 legs,
                 dot,
             });
@@ -219,6 +225,8 @@ fn apply_poses(
     let look = &settings.creature_look;
     let thickness = look.leg_thickness_m;
     let body_shape = Vec3::new(1.0, look.body_height_ratio, look.body_length_ratio);
+    // Sunk a little into the front of the ellipsoid.
+    let nose_at = Vec3::new(0.0, 0.0, -0.9 * look.body_length_ratio);
     let dot_radius = settings.inset.creature_dot_radius_m;
     for (visual, pose, mut root) in &mut roots {
         *root = pose.body;
@@ -231,6 +239,10 @@ fn apply_poses(
             {
                 material.0 = level.clone();
             }
+        }
+        if let Ok((mut nose, _)) = parts.get_mut(visual.nose) {
+            *nose = Transform::from_translation(nose_at * pose.body_radius_m)
+                .with_scale(Vec3::splat(look.nose_radius_fraction * pose.body_radius_m));
         }
         if let Ok((mut dot, material)) = parts.get_mut(visual.dot) {
             let ground = to_local.transform_point3(pose.body.translation.with_y(0.05));

@@ -1,6 +1,6 @@
-//! The HUD: the player's score, the frame rate and the simulation's cost per frame, the
-//! creatures at each level, collisions and falls, the level policy; the game-over banner;
-//! the keys; and any problem with an edited asset file.
+//! The HUD: the player's score, the frame rate and the simulation's cost per frame,
+//! collisions and falls, the level policy; the creatures at each level, with a key to the
+//! level colours; the game-over banner; the keys; and any problem with an edited asset file.
 
 use bevy::app::RunFixedMainLoopSystems;
 use bevy::prelude::*;
@@ -11,7 +11,9 @@ use super::GameSettings;
 use super::controls::{CONTROLS, Notice, policy_name};
 use super::player::Round;
 use super::reload::Problems;
+use super::scene::{ColourByLevel, srgb};
 use crate::config::SimConfig;
+use crate::lod::Lod;
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -32,10 +34,16 @@ struct Counts(Summary);
 #[derive(Component, Clone, Copy, PartialEq, Eq)]
 enum HudText {
     Stats,
+    /// A level's name and how many creatures are at it, beside its colour.
+    Level(Lod),
     Banner,
     Problems,
     Help,
 }
+
+/// A square of a level's colour in the HUD's key (paper figures 5 and 6 colour by level).
+#[derive(Component)]
+struct Swatch(Lod);
 
 fn start_timing(mut timing: ResMut<Timing>) {
     timing.ticks_started = Some(Instant::now());
@@ -82,13 +90,43 @@ fn spawn_hud(mut commands: Commands, settings: Res<GameSettings>) {
         padding: UiRect::axes(px(10), px(6)),
         ..default()
     };
-    commands.spawn((
-        HudText::Stats,
-        Text::default(),
-        TextFont::from_font_size(size),
-        at(Some(12.0), None),
-        panel(),
-    ));
+    let row = |gap: f32| Node {
+        align_items: AlignItems::Center,
+        column_gap: px(gap),
+        ..default()
+    };
+    // The stats, and under them the key: each level's colour, name and count.
+    let key = |key: &mut ChildSpawnerCommands| {
+        // The most detailed first, as the paper names them.
+        for level in Lod::ALL.into_iter().rev() {
+            key.spawn(row(6.0)).with_children(|entry| {
+                entry.spawn((Swatch(level), Node::default(), BackgroundColor::DEFAULT));
+                entry.spawn((HudText::Level(level), Text::default(), TextFont::from_font_size(size)));
+            });
+        }
+    };
+    commands
+        .spawn(Node {
+            flex_direction: FlexDirection::Column,
+            align_items: AlignItems::FlexStart,
+            row_gap: px(4),
+            padding: UiRect::ZERO,
+            ..at(Some(12.0), None)
+        })
+        .with_children(|hud| {
+            let padded = |node: Node| Node {
+                padding: UiRect::axes(px(10), px(6)),
+                ..node
+            };
+            hud.spawn((
+                HudText::Stats,
+                Text::default(),
+                TextFont::from_font_size(size),
+                padded(default()),
+                panel(),
+            ));
+            hud.spawn((padded(row(18.0)), panel().0)).with_children(key);
+        });
     commands.spawn((
         HudText::Help,
         Text::default(),
@@ -154,8 +192,6 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
         "{:.1} fps   simulation {:.2} ms/frame",
         timing.frames_per_s, timing.sim_ms_per_frame
     );
-    let levels: Vec<String> = counts.levels.iter().map(|(l, n)| format!("{l} {n}")).collect();
-    let _ = writeln!(s, "creatures: {}", levels.join(", "));
     let hits: Vec<String> = counts.collisions.iter().map(|(o, n)| format!("{o} {n}")).collect();
     let _ = writeln!(s, "collisions: {}   falls {}", hits.join(", "), counts.falls);
     let rules = &config.rules;
@@ -182,6 +218,10 @@ fn show_hud(
     for (which, mut text, mut node) in &mut texts {
         let (shown, wanted) = match which {
             HudText::Stats => (true, stats_text(&round, &timing, &counts.0, &config)),
+            HudText::Level(level) => {
+                let n = counts.0.levels.get(level.name()).copied().unwrap_or(0);
+                (true, format!("{} {n}", level.name().replace('_', " ")))
+            }
             HudText::Help => {
                 let mut help = CONTROLS.to_owned();
                 if real.elapsed_secs() < notice.until_s {
@@ -228,9 +268,31 @@ fn resize_fonts(settings: Res<GameSettings>, mut texts: Query<(&HudText, &mut Te
         let size = match which {
             HudText::Banner => h.banner_font_size_px,
             HudText::Help => h.font_size_px * 0.85,
-            HudText::Stats | HudText::Problems => h.font_size_px,
+            HudText::Stats | HudText::Level(_) | HudText::Problems => h.font_size_px,
         };
         font.font_size = size.into();
+    }
+}
+
+/// The key's squares: the body colours from `game.ron`, hidden when colouring by level is off.
+fn colour_key(
+    settings: Res<GameSettings>,
+    colour_by_level: Res<ColourByLevel>,
+    mut swatches: Query<(&Swatch, &mut BackgroundColor, &mut Node)>,
+) {
+    if !settings.is_changed() && !colour_by_level.is_changed() {
+        return;
+    }
+    let side = px(settings.hud.font_size_px * 0.8);
+    for (swatch, mut colour, mut node) in &mut swatches {
+        colour.0 = srgb(settings.level_colours_srgb[&swatch.0]);
+        node.width = side;
+        node.height = side;
+        node.display = if colour_by_level.0 {
+            Display::Flex
+        } else {
+            Display::None
+        };
     }
 }
 
@@ -244,5 +306,5 @@ pub(super) fn plugin(app: &mut App) {
                 stop_timing.in_set(RunFixedMainLoopSystems::AfterFixedMainLoop),
             ),
         )
-        .add_systems(Update, (count, show_hud, resize_fonts).chain());
+        .add_systems(Update, ((count, show_hud, resize_fonts).chain(), colour_key));
 }

@@ -1,4 +1,5 @@
-//! The court as a player sees it: ice, lines, walls, the puck, sunlight and shadows. The
+//! The court as a player sees it: ice, lines, walls, the puck and where it is going,
+//! sunlight and shadows. The
 //! court's meshes are built with the simulated world ([`SimStart`]), so they follow an
 //! edited arena file.
 
@@ -7,7 +8,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::Collider;
 
 use super::GameSettings;
-use crate::arena::{Puck, Wall};
+use crate::arena::{Puck, PuckState, Wall};
 use crate::config::{SimConfig, Srgb};
 use crate::lod::Lod;
 use crate::{SimEntity, SimStart};
@@ -23,6 +24,8 @@ pub struct Palette {
     pub lines: Handle<StandardMaterial>,
     pub wall: Handle<StandardMaterial>,
     pub puck: Handle<StandardMaterial>,
+    /// The wedge ahead of the puck: its colour, see-through.
+    pub puck_path: Handle<StandardMaterial>,
     pub leg: Handle<StandardMaterial>,
     pub player_marker: Handle<StandardMaterial>,
     /// A creature's body, by level ([`Lod::ALL`] order).
@@ -56,6 +59,12 @@ fn make_palette(materials: &mut Assets<StandardMaterial>) -> Palette {
         lines: matte(materials, 0.5),
         wall: matte(materials, 0.7),
         puck: matte(materials, 0.3),
+        puck_path: materials.add(StandardMaterial {
+            unlit: true,
+            alpha_mode: AlphaMode::Blend,
+            cull_mode: None,
+            ..default()
+        }),
         leg: matte(materials, 0.6),
         player_marker: materials.add(StandardMaterial {
             unlit: true,
@@ -96,6 +105,9 @@ fn recolour(
             s.uncoloured_srgb
         };
         paint(body, c);
+    }
+    if let Some(mut m) = materials.get_mut(&palette.puck_path) {
+        m.base_color = srgb(s.puck_srgb).with_alpha(settings.puck_look.path_opacity);
     }
 }
 
@@ -151,6 +163,40 @@ fn dress_court(
     }
 }
 
+#[derive(Component)]
+struct PuckPath;
+
+/// A unit wedge flat on the ice: base 1 wide across the origin, tip 1 ahead (-z).
+fn spawn_puck_path(mut commands: Commands, palette: Res<Palette>, mut meshes: ResMut<Assets<Mesh>>) {
+    let wedge = Triangle2d::new(Vec2::new(-0.5, 0.0), Vec2::new(0.5, 0.0), Vec2::Y);
+    commands.spawn((
+        Name::new("puck path"),
+        PuckPath,
+        Mesh3d(meshes.add(Mesh::from(wedge).rotated_by(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)))),
+        MeshMaterial3d(palette.puck_path.clone()),
+    ));
+}
+
+/// The wedge as wide as the puck from its centre, its tip where the puck's front will be
+/// `path_ahead_s` from now: which way the threat comes, and how fast.
+fn point_puck_path(
+    settings: Res<GameSettings>,
+    puck: Res<PuckState>,
+    mut path: Single<(&mut Transform, &mut Visibility), With<PuckPath>>,
+) {
+    let (transform, visibility) = &mut *path;
+    let ahead = puck.velocity * settings.puck_look.path_ahead_s;
+    let Some(direction) = ahead.try_normalize() else {
+        **visibility = Visibility::Hidden;
+        return;
+    };
+    **visibility = Visibility::Inherited;
+    let length = puck.radius_m + ahead.length();
+    **transform = Transform::from_xyz(puck.position.x, 0.02, puck.position.y)
+        .looking_to(Vec3::new(direction.x, 0.0, direction.y), Vec3::Y)
+        .with_scale(Vec3::new(2.0 * puck.radius_m, 1.0, length));
+}
+
 /// The sun, casting shadows; [`aim_the_sun`] sets it and the fill light from the settings.
 fn light_the_court(mut commands: Commands) {
     commands.spawn((Name::new("sun"), Sun, DirectionalLight::default(), Transform::default()));
@@ -194,6 +240,6 @@ pub(super) fn plugin(app: &mut App) {
     app.insert_resource(palette)
         .insert_resource(ColourByLevel(true))
         .add_systems(SimStart, dress_court.after(crate::arena::spawn_arena))
-        .add_systems(Startup, light_the_court)
-        .add_systems(Update, (recolour, aim_the_sun));
+        .add_systems(Startup, (light_the_court, spawn_puck_path))
+        .add_systems(Update, (recolour, aim_the_sun, point_puck_path));
 }

@@ -176,7 +176,7 @@ fn the_shipped_game_file_loads_and_a_bad_colour_is_named() {
     let text = std::fs::read_to_string(assets_root().join("game.ron")).unwrap();
     let dir = scratch_dir("bad_game_file");
     let bad = dir.join("game.ron");
-    std::fs::write(&bad, text.replacen("PointMass: (0.93,", "PointMass: (1.93,", 1)).unwrap();
+    std::fs::write(&bad, text.replacen("PointMass: (0.", "PointMass: (1.", 1)).unwrap();
     let err = load_file::<GameConfig>(&bad).unwrap_err().to_string();
     assert!(
         err.contains("`level_colours_srgb.PointMass.0`") && err.contains("between 0 and 1"),
