@@ -182,9 +182,10 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
     });
     let _ = writeln!(
         s,
-        "ESCAPE THE PUCK   round {}\nsurvived {:.1} s   your collisions {}",
+        "ESCAPE THE PUCK   round {}\nsurvived {:.1} s   best {:.1} s   your collisions {}",
         round.number + 1,
         score.survived_s,
+        round.best_survived_s,
         score.collisions
     );
     let _ = writeln!(
@@ -235,8 +236,10 @@ fn show_hud(
                 (
                     round.over,
                     format!(
-                        "KNOCKED DOWN\nsurvived {score:.1} s with {hits} collision{}\npress Enter to play again",
-                        if hits == 1 { "" } else { "s" }
+                        "KNOCKED DOWN\nsurvived {score:.1} s with {hits} collision{}\n\
+                         best this session {:.1} s\npress Enter to play again",
+                        if hits == 1 { "" } else { "s" },
+                        round.best_survived_s
                     ),
                 )
             }

@@ -37,6 +37,8 @@ pub struct Round {
     /// The player's score so far, or its final score once the round is over.
     pub score: Option<Score>,
     pub over: bool,
+    /// The longest time survived in any round of this session (a new round keeps it).
+    pub best_survived_s: f64,
 }
 
 /// The planar direction the player asks for (length 0 to 1), in world coordinates.
@@ -81,6 +83,7 @@ fn keep_score(
             survived_s: clock.seconds(),
             collisions: record.count.iter().sum(),
         });
+        round.best_survived_s = round.best_survived_s.max(clock.seconds());
     }
 }
 

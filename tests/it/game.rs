@@ -55,6 +55,8 @@ fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
     assert!(round.over, "the player's creature fell: game over");
     assert!(sim.app.world().get_entity(player).is_err(), "the core removed it");
     assert!(round.score.unwrap().collisions >= 1);
+    let first = round.score.unwrap().survived_s;
+    assert_eq!(round.best_survived_s, first, "the best so far is this round's");
 
     // A new round: a fresh world and a new creature to play.
     sim.app.world_mut().write_message(NewRound);
@@ -64,6 +66,10 @@ fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
     assert_eq!(round.number, 1);
     assert!(round.player.is_some_and(|p| p != player));
     assert!(sim.clock().seconds() < 0.1, "the world started over");
+    sim.advance_frame();
+    let round = sim.app.world().resource::<Round>();
+    assert!(round.score.unwrap().survived_s < first);
+    assert_eq!(round.best_survived_s, first, "the session's best outlives its round");
 }
 
 /// The game's rules and hot reload on a copy of the assets, without a window.
