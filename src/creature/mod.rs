@@ -58,13 +58,45 @@ impl PlanarState {
     }
 }
 
-/// Where the creature is in its hop cycle, advanced at every level so that a level switch
-/// can wait for the flight window (paper 3.4).
+/// Where the creature is in its hop cycle, kept at every level so that a level switch can
+/// wait for the flight window (paper 3.4): read from the controller at the rigid level,
+/// advanced by time at the others.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GaitPhase {
     /// Fraction of the hop cycle since the last touchdown, in `[0, 1)`.
     pub cycle: f32,
     pub in_flight: bool,
+    /// Simulated time of the last touchdown, s.
+    pub last_touchdown_s: f32,
+    /// Touchdown to touchdown, s.
+    pub hop_period_s: f32,
+}
+
+impl GaitPhase {
+    /// At `cycle` of a hop of `hop_period_s`, at time `now_s`.
+    pub fn at(cycle: f32, hop_period_s: f32, stance_fraction: f32, now_s: f32) -> Self {
+        Self {
+            cycle,
+            in_flight: cycle >= stance_fraction,
+            last_touchdown_s: now_s - cycle * hop_period_s,
+            hop_period_s,
+        }
+    }
+
+    /// Advances the cycle by `dt` from `now_s` at the given rhythm: stance first, then flight.
+    pub fn advance(&mut self, hop_period_s: f32, stance_fraction: f32, now_s: f32, dt: f32) {
+        let cycle = self.cycle + dt / hop_period_s;
+        *self = if cycle >= 1.0 {
+            Self::at(cycle.fract(), hop_period_s, stance_fraction, now_s + dt)
+        } else {
+            Self {
+                cycle,
+                in_flight: cycle >= stance_fraction,
+                hop_period_s,
+                ..*self
+            }
+        };
+    }
 }
 
 /// A creature whose desired velocity comes from outside (the player's keyboard, a test, an
@@ -201,10 +233,19 @@ pub fn creature_bundle(
     serial: u32,
     level: Lod,
     position: Vec2,
+    now_s: f32,
     rng: &mut WorldRng,
 ) -> (Creature, Lod, PlanarState, GaitPhase, GaitPose) {
     let heading = Vec2::from_angle(rng.0.random_range(-std::f32::consts::PI..std::f32::consts::PI));
     let cycle = rng.0.random_range(0.0..1.0);
+    // In the rhythm and pose its level shows from the first frame: a hybrid's are its table's.
+    let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
+        (Lod::Hybrid, Some(table)) => {
+            let (period, stance) = table.rhythm(0.0);
+            (period, stance, table.pose(0.0, cycle))
+        }
+        _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
+    };
     (
         Creature { kind, serial },
         level,
@@ -213,11 +254,8 @@ pub fn creature_bundle(
             velocity: Vec2::ZERO,
             heading,
         },
-        GaitPhase {
-            cycle,
-            in_flight: false,
-        },
-        params.standing_pose,
+        GaitPhase::at(cycle, hop_period_s, stance_fraction, now_s),
+        pose,
     )
 }
 
@@ -292,6 +330,7 @@ fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResM
                 serials.take(),
                 level,
                 spot,
+                0.0,
                 &mut rng,
             ));
         }

@@ -57,6 +57,23 @@ impl GaitPose {
         ]
     }
 
+    /// The body's rotation when it faces `heading` on the plane: yaw, then pitch, then roll
+    /// (what [`crate::models::rigid::rigid_pose`] reads back). Rapier's body frame: x forward,
+    /// y up, z to the right.
+    pub fn body_rotation(&self, heading: Vec2) -> Quat {
+        Quat::from_euler(
+            EulerRot::YZX,
+            -heading.y.atan2(heading.x),
+            self.pitch_rad,
+            self.roll_rad,
+        )
+    }
+
+    /// Unit vector from hip to foot in the body's frame.
+    pub fn leg_direction(&self) -> Vec3 {
+        Vec3::new(self.leg_forward_rad.tan(), -1.0, -self.leg_sideways_rad.tan()).normalize()
+    }
+
     fn lerp(self, other: Self, t: f32) -> Self {
         let (a, b) = (self.to_row(), other.to_row());
         Self::from_row(&std::array::from_fn::<f32, 6, _>(|i| a[i] + (b[i] - a[i]) * t))

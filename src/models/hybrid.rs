@@ -8,9 +8,8 @@ use crate::creature::GaitPhase;
 use crate::gait::{GaitPose, GaitTable};
 
 /// Advances the hop cycle at the table's rhythm for `speed` and poses the body from it.
-pub fn play_gait(gait: &mut GaitPhase, pose: &mut GaitPose, table: &GaitTable, speed: f32, dt: f32) {
+pub fn play_gait(gait: &mut GaitPhase, pose: &mut GaitPose, table: &GaitTable, speed: f32, now_s: f32, dt: f32) {
     let (period, stance) = table.rhythm(speed);
-    gait.cycle = (gait.cycle + dt / period).fract();
-    gait.in_flight = gait.cycle >= stance;
+    gait.advance(period, stance, now_s, dt);
     *pose = table.pose(speed, gait.cycle);
 }

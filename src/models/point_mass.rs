@@ -36,10 +36,9 @@ pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt
     }
 }
 
-/// Advances the hop cycle by time: stance first, then flight.
-pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, dt: f32) {
-    gait.cycle = (gait.cycle + dt * kind.cycles_per_s).fract();
-    gait.in_flight = gait.cycle >= kind.stance_fraction;
+/// Advances the hop cycle by time at the kind's own rhythm.
+pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, now_s: f32, dt: f32) {
+    gait.advance(1.0 / kind.cycles_per_s, kind.stance_fraction, now_s, dt);
 }
 
 /// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
@@ -56,7 +55,7 @@ fn step_point_masses(
         &mut GaitPose,
     )>,
 ) {
-    let dt = clock.dt;
+    let (dt, now) = (clock.dt, clock.seconds() as f32);
     for_each_creature!(config.scenario.creature_count(), creatures, |(
         creature,
         lod,
@@ -76,11 +75,11 @@ fn step_point_masses(
         match (lod, &kind.gait) {
             (Lod::PointMass, _) => {
                 step_planar(&mut state, desired.0, kind, dt);
-                advance_gait(&mut gait, kind, dt);
+                advance_gait(&mut gait, kind, now, dt);
             }
             (Lod::Hybrid, Some(table)) => {
                 step_planar(&mut state, desired.0, kind, dt);
-                hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), dt);
+                hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), now, dt);
             }
             _ => {}
         }
@@ -180,11 +179,22 @@ mod tests {
         let k = kind();
         let mut g = GaitPhase::default();
         let mut flight_ticks = 0;
-        for _ in 0..1000 {
-            advance_gait(&mut g, &k, 0.001);
+        let mut touchdowns = Vec::new();
+        for i in 0..1100 {
+            advance_gait(&mut g, &k, i as f32 * 0.001, 0.001);
             flight_ticks += g.in_flight as u32;
+            if touchdowns.last() != Some(&g.last_touchdown_s) {
+                touchdowns.push(g.last_touchdown_s);
+            }
         }
-        // 1 s at 2 cycles/s with 60 % flight.
+        // 1.1 s at 2 cycles/s with 60 % flight (the last 0.1 s in stance): touchdowns at 0
+        // (the start), 0.5 and 1 s.
         assert!((flight_ticks as i32 - 600).abs() <= 2, "{flight_ticks}");
+        assert_eq!(g.hop_period_s, 0.5);
+        assert_eq!(touchdowns.len(), 3, "{touchdowns:?}");
+        assert!(
+            (touchdowns[1] - 0.5).abs() < 2e-3 && (touchdowns[2] - 1.0).abs() < 2e-3,
+            "{touchdowns:?}"
+        );
     }
 }

@@ -203,6 +203,7 @@ fn detect_collisions(
 /// Removes the fallen and starts a new creature of the same kind in a free spot.
 fn respawn_fallen(
     mut commands: Commands,
+    clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
     puck: Res<PuckState>,
@@ -245,6 +246,7 @@ fn respawn_fallen(
             serials.take(),
             *lod,
             spot,
+            clock.seconds() as f32,
             &mut rng,
         ));
     }

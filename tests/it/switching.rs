@@ -9,30 +9,50 @@ use crate::support::*;
 use simlod::SimStage;
 use simlod::config::SimConfig;
 use simlod::creature::{Creature, PlanarState};
+use simlod::gait::GaitPose;
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, LevelSwitched, Lod};
 use simlod::models::rigid::RigidPart;
+use simlod::outcome::CollisionRecord;
 
-/// A switch as the test saw it: the message and the creature's state at the end of the tick
-/// before and of the tick it switched in.
+/// What the test sees of a creature at the end of a tick.
+#[derive(Clone, Copy, Debug)]
+struct Seen {
+    state: PlanarState,
+    pose: GaitPose,
+    touching: bool,
+}
+
+/// A switch as the test saw it: the message and the creature at the end of the tick before
+/// and of the tick it switched in.
 #[derive(Clone, Debug)]
 struct Observed {
     switch: LevelSwitched,
-    before: PlanarState,
-    after: PlanarState,
+    before: Seen,
+    after: Seen,
 }
 
 #[derive(Resource, Default)]
 struct Watch {
-    last: HashMap<Entity, PlanarState>,
+    last: HashMap<Entity, Seen>,
     seen: Vec<Observed>,
 }
 
-fn remember(mut watch: ResMut<Watch>, creatures: Query<(Entity, &PlanarState)>) {
-    watch.last = creatures.iter().map(|(e, s)| (e, *s)).collect();
+type Looks<'a> = (&'a PlanarState, &'a GaitPose, &'a CollisionRecord);
+
+fn seen((state, pose, record): Looks) -> Seen {
+    Seen {
+        state: *state,
+        pose: *pose,
+        touching: record.touching.iter().any(|&t| t),
+    }
 }
 
-fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>, creatures: Query<&PlanarState>) {
+fn remember(mut watch: ResMut<Watch>, creatures: Query<(Entity, Looks)>) {
+    watch.last = creatures.iter().map(|(e, looks)| (e, seen(looks))).collect();
+}
+
+fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>, creatures: Query<Looks>) {
     for s in switched.read() {
         let (Some(before), Ok(after)) = (watch.last.get(&s.creature).copied(), creatures.get(s.creature)) else {
             continue;
@@ -40,9 +60,14 @@ fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>,
         watch.seen.push(Observed {
             switch: *s,
             before,
-            after: *after,
+            after: seen(after),
         });
     }
+}
+
+/// Height of the foot's centre above the ground in a pose.
+fn foot_height(pose: &GaitPose) -> f32 {
+    pose.body_height_m + (pose.body_rotation(Vec2::X) * pose.leg_direction()).y * pose.leg_length_m
 }
 
 /// A simulation stepped one tick per update, watching every switch.
@@ -66,6 +91,11 @@ fn influence_config() -> SimConfig {
 fn switches_happen_only_inside_the_flight_window_unless_a_collision_forces_them() {
     let config = influence_config();
     let (open, close) = config.rules.flight_window;
+    let foot_radius = config.kinds[config.kind_index("hopper").unwrap()]
+        .rigid
+        .as_ref()
+        .unwrap()
+        .foot_radius_m;
     let mut sim = watched(config);
     sim.run_for(20.0);
     let seen = &sim.app.world().resource::<Watch>().seen;
@@ -78,12 +108,26 @@ fn switches_happen_only_inside_the_flight_window_unless_a_collision_forces_them(
             "switched at {p} of the flight phase: {:?}",
             o.switch
         );
+        // Seen from outside the switch: the foot was off the ground, whether the bodies or
+        // the gait table put it there.
+        let clearance = foot_height(&o.before.pose) - foot_radius;
+        assert!(
+            clearance > 0.0,
+            "{:?}: the foot was {clearance} m off the ground",
+            o.switch
+        );
     }
     for o in &forced {
         assert_eq!(
             o.switch.to,
             Lod::Rigid,
             "only a collision skips the window, and it goes rigid"
+        );
+        // The switch reads the contacts of the tick before.
+        assert!(
+            o.before.touching,
+            "{:?} skipped the window without a collision",
+            o.switch
         );
     }
 }
@@ -96,22 +140,59 @@ fn at_a_switch_the_body_does_not_jump() {
     let seen = sim.app.world().resource::<Watch>().seen.clone();
     assert!(seen.len() >= 30);
     for o in seen.iter().filter(|o| o.switch.flight_progress.is_some()) {
+        let (before, after) = (o.before.state, o.after.state);
         // Where the body would have been after one more tick of its own motion.
-        let expected = o.before.position + o.before.velocity * dt;
-        let jump = o.after.position.distance(expected);
+        let expected = before.position + before.velocity * dt;
+        let jump = after.position.distance(expected);
         assert!(jump < 0.01, "{:?}: position jumped {jump} m", o.switch);
-        let turn = o.after.heading.angle_to(o.before.heading).abs().to_degrees();
+        let turn = after.heading.angle_to(before.heading).abs().to_degrees();
         assert!(turn < 2.0, "{:?}: heading turned {turn} degrees", o.switch);
         // In flight the planar velocity of a hopper is nearly constant; within a hop the
         // rigid body's planar speed varies by about 0.2 m/s, so more than 0.3 m/s is a pop.
-        let kick = o.after.velocity.distance(o.before.velocity);
+        let kick = after.velocity.distance(before.velocity);
         assert!(
             kick < 0.3,
             "{:?}: velocity changed by {kick} m/s: {:?} {:?}",
             o.switch,
-            o.before,
-            o.after
+            before,
+            after
         );
+    }
+}
+
+#[test]
+fn a_hopper_becomes_rigid_in_the_pose_the_gait_table_gave_it() {
+    let mut sim = watched(influence_config());
+    sim.run_for(20.0);
+    let seen = sim.app.world().resource::<Watch>().seen.clone();
+    let ups: Vec<_> = seen
+        .iter()
+        .filter(|o| o.switch.flight_progress.is_some() && (o.switch.from, o.switch.to) == (Lod::Hybrid, Lod::Rigid))
+        .collect();
+    assert!(ups.len() >= 10, "{} switches up to rigid", ups.len());
+    for o in ups {
+        // The hybrid's table pose at the end of the tick before, against the bodies' pose
+        // after their first physics step. In flight the body rises or falls at most about
+        // 1.5 m/s, 6 mm in a 240 Hz tick; the leg swings toward its touchdown angle at up to
+        // about 2 degrees a tick (both from the rigid hopper's recorded hops).
+        let (b, a) = (o.before.pose, o.after.pose);
+        let rise = (a.body_height_m - b.body_height_m).abs();
+        assert!(
+            rise < 0.01,
+            "{:?}: body height jumped {rise} m: {b:?} -> {a:?}",
+            o.switch
+        );
+        let degrees = |x: f32, y: f32| (x - y).abs().to_degrees();
+        for (what, d, limit) in [
+            ("pitch", degrees(a.pitch_rad, b.pitch_rad), 1.0),
+            ("roll", degrees(a.roll_rad, b.roll_rad), 1.0),
+            ("leg forward", degrees(a.leg_forward_rad, b.leg_forward_rad), 3.0),
+            ("leg sideways", degrees(a.leg_sideways_rad, b.leg_sideways_rad), 3.0),
+        ] {
+            assert!(d < limit, "{:?}: {what} jumped {d} degrees: {b:?} -> {a:?}", o.switch);
+        }
+        let stretch = (a.leg_length_m - b.leg_length_m).abs();
+        assert!(stretch < 0.01, "{:?}: leg length jumped {stretch} m", o.switch);
     }
 }
 
@@ -201,6 +282,7 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
     config.rules.min_dwell_s = 0.1;
     config.rules.release_margin_m = 0.3;
     let mut sim = HeadlessSim::new(config);
+    let mut baseline = None;
     while sim.clock().seconds() < 600.0 {
         sim.run_for(60.0);
         let world = sim.app.world_mut();
@@ -214,6 +296,17 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
         let parts = world.query::<&RigidPart>().iter(world).count();
         let bodies = world.query::<&RigidBody>().iter(world).count();
         let rapier_bodies = world.query::<&RapierRigidBodySet>().single(world).unwrap().bodies.len();
+        let rapier_colliders = world
+            .query::<&RapierContextColliders>()
+            .single(world)
+            .unwrap()
+            .colliders
+            .len();
+        let colliders = world.query::<&Collider>().iter(world).count();
+        let joints = world.query::<&RapierContextJoints>().single(world).unwrap();
+        let multibodies = joints.multibody_joints.multibodies().count();
+        let impulse_joints = joints.impulse_joints.len();
+        let entities = world.iter_entities().count();
         assert_eq!(
             parts,
             3 * rigid,
@@ -222,6 +315,12 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
         );
         assert_eq!(bodies, parts + 6, "plus ground, four walls and the puck");
         assert_eq!(rapier_bodies, bodies, "rapier holds exactly the bodies the world has");
+        assert_eq!(rapier_colliders, colliders, "and exactly its colliders");
+        assert_eq!(multibodies, rigid, "one multibody per rigid creature");
+        assert_eq!(impulse_joints, 0);
+        // Every other entity (creatures, court, rapier's context, the app's own) is fixed.
+        let others = entities - 3 * rigid;
+        assert_eq!(*baseline.get_or_insert(others), others, "entities besides the bodies");
     }
     let summary = sim.summary(0.0);
     eprintln!("soak: {:?} switches, {} falls", summary.switches, summary.falls);

@@ -20,13 +20,7 @@ use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindTable, PlanarSta
 use crate::outcome::FallQueue;
 
 /// Foot centre this far above its resting height still counts as on the ground.
-const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
-/// Below this desired speed the heading is kept as it is.
-const TURN_MIN_SPEED_M_PER_S: f32 = 0.2;
-/// Largest yaw error acted on at once, so a reversal turns smoothly rather than violently.
-const MAX_YAW_ERROR_RAD: f32 = 0.6;
-/// Bound of the integral speed correction.
-const MAX_SPEED_CORRECTION_M_PER_S: f32 = 1.0;
+pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
 /// Share of the leg's twist about its own axis (relative to the body) removed each tick. The
 /// leg is thin, so its twist inertia is tiny: the damping is scaled to it, or it would
 /// overshoot and blow up.
@@ -84,11 +78,13 @@ impl Raibert {
         }
     }
 
-    /// The shared gait phase: fraction of the hop since touchdown, and whether in flight.
+    /// The shared gait phase, as the bodies last touched down and lifted off.
     pub fn gait_phase(&self, now: f32) -> GaitPhase {
         GaitPhase {
             cycle: ((now - self.last_touchdown_s) / self.hop_period_s).clamp(0.0, 0.999),
             in_flight: self.phase == StancePhase::Flight,
+            last_touchdown_s: self.last_touchdown_s,
+            hop_period_s: self.hop_period_s,
         }
     }
 }
@@ -106,12 +102,9 @@ struct Sensed {
     foot_height: f32,
 }
 
-/// Faster than this, a body's state is a numerical blow-up, not motion.
-const BLOW_UP_SPEED_M_PER_S: f32 = 100.0;
-
 impl Sensed {
     /// Finite and not absurdly fast: anything else is a blow-up, handled as a fall.
-    fn is_sane(&self) -> bool {
+    fn is_sane(&self, blow_up_speed_m_per_s: f32) -> bool {
         let finite = self.body_velocity.is_finite()
             && self.body_spin.is_finite()
             && self.leg_spin.is_finite()
@@ -119,7 +112,7 @@ impl Sensed {
             && self.leg_rate.is_finite()
             && self.foot_height.is_finite()
             && self.body_rotation.is_finite();
-        finite && self.body_velocity.length() < BLOW_UP_SPEED_M_PER_S
+        finite && self.body_velocity.length() < blow_up_speed_m_per_s
     }
 
     fn read(hopper: &RigidHopper, parts: &Query<(&mut Transform, &mut Velocity, &mut ExternalForce)>) -> Option<Self> {
@@ -178,7 +171,7 @@ impl Raibert {
                     let error = desired - s.body_velocity.xz();
                     let local_error = Vec2::new(error.dot(along), error.dot(along.perp()));
                     self.speed_correction = (self.speed_correction + local_error * c.speed_integral_gain)
-                        .clamp_length_max(MAX_SPEED_CORRECTION_M_PER_S);
+                        .clamp_length_max(c.max_speed_correction_m_per_s);
                 }
                 self.last_touchdown_s = now;
                 self.phase = StancePhase::Compression;
@@ -224,12 +217,12 @@ impl Raibert {
                 let level = up.cross(Vec3::Y) * c.attitude_kp_nm_per_rad
                     - Vec3::new(s.body_spin.x, 0.0, s.body_spin.z) * c.attitude_kd_nm_s_per_rad;
                 let yaw = yaw_of(s.body_rotation);
-                let wanted = if desired.length() > TURN_MIN_SPEED_M_PER_S {
+                let wanted = if desired.length() > c.turn_min_speed_m_per_s {
                     (-desired.y).atan2(desired.x)
                 } else {
                     yaw
                 };
-                let yaw_error = wrap_angle(wanted - yaw).clamp(-MAX_YAW_ERROR_RAD, MAX_YAW_ERROR_RAD);
+                let yaw_error = wrap_angle(wanted - yaw).clamp(-c.max_yaw_error_rad, c.max_yaw_error_rad);
                 let turn = (yaw_error * c.yaw_kp_nm_per_rad - s.body_spin.y * c.yaw_kd_nm_s_per_rad)
                     .clamp(-c.yaw_max_torque_nm, c.yaw_max_torque_nm);
                 Torques {
@@ -263,7 +256,7 @@ pub(super) fn control_hoppers(
         let Some(sensed) = Sensed::read(hopper, &parts) else {
             continue;
         };
-        if !sensed.is_sane() {
+        if !sensed.is_sane(r.fall.blow_up_speed_m_per_s) {
             // Calm the bodies so the physics step survives until the fall removes them.
             falls.push(creature.serial, entity);
             for part in hopper.parts() {

@@ -15,7 +15,7 @@ use bevy_rapier3d::prelude::*;
 
 use crate::arena::{Ground, Puck, Wall};
 use crate::config::RigidConfig;
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
+use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::Lod;
 use crate::outcome::{CollisionRecord, FallQueue, Obstacle};
@@ -50,19 +50,30 @@ fn leg_joint(r: &RigidConfig) -> PrismaticJoint {
     let mut joint = PrismaticJointBuilder::new(Vec3::NEG_Y)
         .local_anchor1(Vec3::ZERO)
         .local_anchor2(Vec3::Y * rest)
-        .limits([r.leg_min_length_m - rest, r.controller.thrust_max_m + 0.02])
+        .limits([r.leg_min_length_m - rest, leg_length_range_m(r).1 - rest])
         .build();
     joint.set_contacts_enabled(false);
     joint
 }
 
+/// The leg's shortest and longest length: its stops, a little past the longest thrust.
+fn leg_length_range_m(r: &RigidConfig) -> (f32, f32) {
+    (
+        r.leg_min_length_m,
+        r.leg_rest_length_m + r.controller.thrust_max_m + LEG_STOP_BEYOND_THRUST_M,
+    )
+}
+
+/// How far past the longest thrust the leg's stop is, so the thrust never rides on it.
+const LEG_STOP_BEYOND_THRUST_M: f32 = 0.02;
+
 /// The physics components every part shares.
-fn part(creature: Entity, transform: Transform, velocity: Vec3) -> impl Bundle {
+fn part(creature: Entity, transform: Transform) -> impl Bundle {
     (
         RigidPart { creature },
         RigidBody::Dynamic,
         transform,
-        Velocity::linear(velocity),
+        Velocity::zero(),
         ExternalForce::default(),
         Sleeping::disabled(),
         ActiveEvents::COLLISION_EVENTS,
@@ -70,24 +81,37 @@ fn part(creature: Entity, transform: Transform, velocity: Vec3) -> impl Bundle {
     )
 }
 
-/// Builds the bodies of a creature at the rigid level: the hip at `hip_height_m` above its
-/// planar position, the leg hanging straight down at rest length, facing its heading.
+/// How a new multibody starts: the pose to set its joints to and its body's velocity. Rapier
+/// builds a multibody at rest with its joints at zero whatever the bodies were spawned with,
+/// so both are applied to its coordinates once it exists, then this is removed.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct RigidStart {
+    /// The leg's rotation from hanging straight down, in the body's frame (scaled axis).
+    pub hip_rotation: Vec3,
+    /// The leg's length past its rest length (the prismatic joint's coordinate).
+    pub leg_extension_m: f32,
+    pub velocity: Vec3,
+}
+
+/// Builds the bodies of a creature at the rigid level in `pose`, facing its heading at its
+/// planar position, the hip at the pose's body height.
 pub fn spawn_hopper(
     commands: &mut Commands,
     creature: Entity,
     r: &RigidConfig,
     mass_kg: f32,
     state: &PlanarState,
-    hip_height_m: f32,
+    pose: &GaitPose,
 ) -> RigidHopper {
-    let yaw = Quat::from_rotation_y(-state.heading.y.atan2(state.heading.x));
-    let hip = Vec3::new(state.position.x, hip_height_m, state.position.y);
-    let velocity = Vec3::new(state.velocity.x, 0.0, state.velocity.y);
+    let body_rotation = pose.body_rotation(state.heading);
+    let leg_rotation = body_rotation * Quat::from_rotation_arc(Vec3::NEG_Y, pose.leg_direction());
+    let hip = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
+    let foot = hip + leg_rotation * Vec3::NEG_Y * pose.leg_length_m;
     let (hx, hy, hz) = r.body_half_extents_m;
     let body = commands
         .spawn((
             Name::new("hopper body"),
-            part(creature, Transform::from_translation(hip).with_rotation(yaw), velocity),
+            part(creature, Transform::from_translation(hip).with_rotation(body_rotation)),
             Collider::cuboid(hx, hy, hz),
             ColliderMassProperties::Mass(mass_kg),
         ))
@@ -101,7 +125,7 @@ pub fn spawn_hopper(
     let upper_leg = commands
         .spawn((
             Name::new("hopper upper leg"),
-            part(creature, Transform::from_translation(hip).with_rotation(yaw), velocity),
+            part(creature, Transform::from_translation(hip).with_rotation(leg_rotation)),
             Collider::compound(vec![(
                 Vec3::new(0.0, -upper_len / 2.0, 0.0),
                 Quat::IDENTITY,
@@ -115,11 +139,7 @@ pub fn spawn_hopper(
     let lower_leg = commands
         .spawn((
             Name::new("hopper lower leg"),
-            part(
-                creature,
-                Transform::from_translation(hip - Vec3::Y * r.leg_rest_length_m).with_rotation(yaw),
-                velocity,
-            ),
+            part(creature, Transform::from_translation(foot).with_rotation(leg_rotation)),
             Collider::compound(vec![
                 (Vec3::ZERO, Quat::IDENTITY, Collider::ball(r.foot_radius_m)),
                 (
@@ -158,6 +178,52 @@ pub fn rigid_pose(body: &Transform, foot: &Transform) -> GaitPose {
     }
 }
 
+/// The pose a creature enters the rigid level in (paper 3.4: the motion continues): the
+/// gait table's for its speed and hop phase where its kind has one, else upright at the
+/// height its level last had; the hip raised if need be so the foot starts clear of the
+/// ground. Also the body's vertical velocity, from the table's change of height over the hop.
+fn entry_pose(
+    kind: &KindParams,
+    r: &RigidConfig,
+    state: &PlanarState,
+    gait: &GaitPhase,
+    last: &GaitPose,
+) -> (GaitPose, RigidStart) {
+    let speed = state.velocity.length();
+    let (mut pose, climb) = match &kind.gait {
+        Some(table) => {
+            let (period, _) = table.rhythm(speed);
+            let step = 1.0 / (table.sample_hz * period);
+            let (now, next) = (table.pose(speed, gait.cycle), table.pose(speed, gait.cycle + step));
+            (now, (next.body_height_m - now.body_height_m) * table.sample_hz)
+        }
+        // Without a table: the body where the lower level had it, the leg hanging at rest.
+        None => (
+            GaitPose {
+                body_height_m: last.body_height_m,
+                leg_length_m: r.leg_rest_length_m,
+                ..default()
+            },
+            0.0,
+        ),
+    };
+    let (shortest, longest) = leg_length_range_m(r);
+    pose.leg_length_m = pose.leg_length_m.clamp(shortest, longest);
+    let foot_drop = -(pose.body_rotation(state.heading) * pose.leg_direction()).y * pose.leg_length_m;
+    pose.body_height_m = pose
+        .body_height_m
+        .max(foot_drop + r.foot_radius_m + FOOT_START_CLEARANCE_M);
+    let start = RigidStart {
+        hip_rotation: Quat::from_rotation_arc(Vec3::NEG_Y, pose.leg_direction()).to_scaled_axis(),
+        leg_extension_m: pose.leg_length_m - r.leg_rest_length_m,
+        velocity: Vec3::new(state.velocity.x, climb, state.velocity.y),
+    };
+    (pose, start)
+}
+
+/// Gap left under the foot of a hopper that starts with its foot below the ground.
+const FOOT_START_CLEARANCE_M: f32 = 0.005;
+
 /// Gives every rigid creature without bodies its bodies and a fresh controller.
 fn build_bodies(
     mut commands: Commands,
@@ -174,33 +240,49 @@ fn build_bodies(
         let (Lod::Rigid, Some(r)) = (lod, &kind.rigid) else {
             continue;
         };
-        // The body at the height the lower level had it, the leg hanging at rest length
-        // clear of the ground; the hop resumes where it was.
-        let hip = pose.body_height_m.max(r.leg_rest_length_m + r.foot_radius_m + 0.005);
-        let hopper = spawn_hopper(&mut commands, entity, r, kind.mass_kg, state, hip);
+        let (pose, start) = entry_pose(kind, r, state, gait, pose);
+        let hopper = spawn_hopper(&mut commands, entity, r, kind.mass_kg, state, &pose);
+        // The hop resumes where it was.
         let mut raibert = Raibert::new(r, kind.mass_kg, state.velocity, now);
         raibert.last_touchdown_s = now - gait.cycle * raibert.hop_period_s;
         raibert.last_liftoff_s = (raibert.last_touchdown_s + raibert.stance_s).min(now);
-        commands.entity(entity).insert((hopper, raibert));
+        commands.entity(entity).insert((hopper, raibert, start));
     }
 }
 
-/// Rapier builds a new multibody at rest whatever velocities its bodies were given: set the
-/// free root's velocity, which carries the whole tree, from the planar state.
-fn carry_velocity_into_bodies(
-    mut context: Query<&mut RapierContextJoints>,
-    new: Query<(&PlanarState, &RigidHopper), Added<RigidHopper>>,
+/// Puts a new multibody in its entry pose and sets it moving: the hip and leg joints to the
+/// pose's angles and length, the free root's velocity (which carries the whole tree) to the
+/// body's.
+fn start_multibodies(
+    mut commands: Commands,
+    mut context: Query<(&mut RapierContextJoints, &mut RapierRigidBodySet)>,
+    new: Query<(Entity, &RigidStart, &RigidHopper)>,
     handles: Query<&RapierMultibodyJointHandle>,
 ) {
-    let Ok(mut joints) = context.single_mut() else { return };
-    for (state, hopper) in &new {
+    let Ok((mut joints, mut bodies)) = context.single_mut() else {
+        return;
+    };
+    for (creature, start, hopper) in &new {
+        commands.entity(creature).remove::<RigidStart>();
         let Ok(handle) = handles.get(hopper.upper_leg) else {
             continue;
         };
-        if let Some((multibody, _)) = joints.multibody_joints.get_mut(handle.0) {
-            let mut velocity = multibody.generalized_velocity_mut();
-            velocity[0] = state.velocity.x;
-            velocity[2] = state.velocity.y;
+        let Some((multibody, _)) = joints.multibody_joints.get_mut(handle.0) else {
+            continue;
+        };
+        for link in multibody.links_mut() {
+            match link.joint.ndofs() {
+                3 => link.joint.apply_displacement(&start.hip_rotation.to_array()),
+                1 => link.joint.apply_displacement(&[start.leg_extension_m]),
+                _ => {}
+            }
+        }
+        // The root's pose is read from its body, where it was spawned.
+        multibody.forward_kinematics(&bodies.bodies, true);
+        multibody.update_rigid_bodies(&mut bodies.bodies, true);
+        let mut velocity = multibody.generalized_velocity_mut();
+        for (i, v) in start.velocity.to_array().into_iter().enumerate() {
+            velocity[i] = v;
         }
     }
 }
@@ -247,6 +329,8 @@ fn observe_hoppers(
         *gait = raibert.gait_phase(now);
         if let Ok((foot, _, _)) = parts.get(hopper.lower_leg) {
             *pose = rigid_pose(body, foot);
+            // The controller sees a touchdown next tick; the bodies show it now.
+            gait.in_flight &= foot.translation.y > r.foot_radius_m + controller::FOOT_CONTACT_TOLERANCE_M;
         }
 
         let mut touching = [false; 3];
@@ -288,7 +372,7 @@ pub(super) fn plugin(app: &mut App) {
         )
         .add_systems(
             FixedUpdate,
-            carry_velocity_into_bodies
+            start_multibodies
                 .after(PhysicsSet::SyncBackend)
                 .before(PhysicsSet::StepSimulation),
         )
