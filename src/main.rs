@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use simlod::config::{CreatureDef, CreatureGroup, SimConfig, load_file};
+use simlod::config::{CreatureDef, CreatureGroup, SimConfig, Validate, Validator, load_file};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::LevelPolicy;
 use simlod::outcome::Summary;
@@ -103,6 +103,12 @@ impl RecordGaitArgs {
             self.creature.display(),
             speeds.join(",")
         );
+        // A table the loader would refuse is not written: the old one stays.
+        let mut check = Validator::default();
+        table.validate(&mut check);
+        check
+            .finish(&out)
+            .map_err(|e| format!("the recording is not a usable gait table, so it was not written:\n{e}"))?;
         if let Some(dir) = out.parent() {
             std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
         }
@@ -256,10 +262,11 @@ struct BenchArgs {
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
-    if v.is_finite() && v > 0.0 && v <= 1e6 {
+    // The models keep time in f32 seconds: past 1e4 s its steps grow toward a tick's length.
+    if v.is_finite() && v > 0.0 && v <= 1e4 {
         Ok(v)
     } else {
-        Err(format!("must be between 0 and 1e6 seconds, got {v}"))
+        Err(format!("must be more than 0 and at most 10000 seconds, got {v}"))
     }
 }
 

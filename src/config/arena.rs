@@ -39,10 +39,24 @@ impl ArenaConfig {
     }
 }
 
+/// The longest side of a court: the neighbour grid covers the whole court with cells of a
+/// few metres, so a larger one would take gigabytes (10 km holds a million creatures at the
+/// default scenario's density).
+pub const MAX_COURT_SIDE_M: f32 = 10_000.0;
+
 impl Validate for ArenaConfig {
     fn validate(&self, v: &mut Validator) {
-        v.positive("court_length_m", self.court_length_m);
-        v.positive("court_width_m", self.court_width_m);
+        for (field, side) in [
+            ("court_length_m", self.court_length_m),
+            ("court_width_m", self.court_width_m),
+        ] {
+            v.positive(field, side);
+            v.require(
+                !(side > MAX_COURT_SIDE_M),
+                field,
+                format!("must be at most {MAX_COURT_SIDE_M} m, got {side}"),
+            );
+        }
         v.positive("wall_height_m", self.wall_height_m);
         v.positive("wall_thickness_m", self.wall_thickness_m);
         v.non_negative("respawn_puck_clearance_m", self.respawn_puck_clearance_m);

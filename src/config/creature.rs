@@ -91,6 +91,12 @@ pub struct RaibertConfig {
     pub yaw_kd_nm_s_per_rad: f32,
     /// Largest yaw torque the foot's grip on the ground can take.
     pub yaw_max_torque_nm: f32,
+    /// Largest yaw error acted on at once, so a reversal turns smoothly, not violently.
+    pub max_yaw_error_rad: f32,
+    /// Below this desired speed the body keeps its heading.
+    pub turn_min_speed_m_per_s: f32,
+    /// Bound of the integral correction of the commanded velocity.
+    pub max_speed_correction_m_per_s: f32,
 }
 
 /// When a rigid creature has fallen.
@@ -101,6 +107,8 @@ pub struct FallConfig {
     pub body_min_height_m: f32,
     /// The body's up axis tilted further than this from vertical.
     pub max_tilt_deg: f32,
+    /// Any part faster than this is a numerical blow-up, not motion: handled as a fall.
+    pub blow_up_speed_m_per_s: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -207,6 +215,11 @@ impl Validate for RigidConfig {
             format!("must be below leg_rest_length_m ({})", self.leg_rest_length_m),
         );
         v.require(
+            self.upper_leg_length_m > 2.0 * self.leg_radius_m && self.lower_leg_length_m > self.foot_radius_m,
+            "upper_leg_length_m",
+            "each leg part must be longer than it is thick: upper_leg_length_m above twice leg_radius_m, lower_leg_length_m above foot_radius_m",
+        );
+        v.require(
             self.lower_leg_length_m + y < self.leg_min_length_m,
             "lower_leg_length_m",
             "the lower leg would reach into the body at the shortest leg: keep lower_leg_length_m + body half height below leg_min_length_m",
@@ -228,9 +241,12 @@ impl Validate for RigidConfig {
                 ("yaw_kp_nm_per_rad", c.yaw_kp_nm_per_rad),
                 ("yaw_kd_nm_s_per_rad", c.yaw_kd_nm_s_per_rad),
                 ("yaw_max_torque_nm", c.yaw_max_torque_nm),
+                ("turn_min_speed_m_per_s", c.turn_min_speed_m_per_s),
+                ("max_speed_correction_m_per_s", c.max_speed_correction_m_per_s),
             ] {
                 v.non_negative(name, value);
             }
+            v.within("max_yaw_error_rad", c.max_yaw_error_rad, 0.01, std::f32::consts::PI);
             v.require(
                 c.thrust_initial_m <= c.thrust_max_m,
                 "thrust_initial_m",
@@ -240,6 +256,7 @@ impl Validate for RigidConfig {
         v.nested("fall", |v| {
             v.positive("body_min_height_m", self.fall.body_min_height_m);
             v.within("max_tilt_deg", self.fall.max_tilt_deg, 1.0, 180.0);
+            v.positive("blow_up_speed_m_per_s", self.fall.blow_up_speed_m_per_s);
         });
     }
 }

@@ -19,7 +19,7 @@ pub fn parse_ron<T: DeserializeOwned + Validate>(bytes: &[u8], file: &Path) -> R
             format!("not a RON text file: invalid UTF-8 at byte {}", e.valid_up_to()),
         )
     })?;
-    let value: T = ron::from_str(text).map_err(|e| parse_error(file, e))?;
+    let value: T = parse_text(text).map_err(|(path, e)| parse_error(file, &path, e))?;
     let mut v = Validator::default();
     value.validate(&mut v);
     v.finish(file)?;
@@ -32,14 +32,37 @@ pub fn load_file<T: DeserializeOwned + Validate>(file: &Path) -> Result<T, Confi
     parse_ron(&bytes, file)
 }
 
-fn parse_error(file: &Path, e: ron::error::SpannedError) -> ConfigError {
+/// Deserializes `text`, keeping the path of the field being read when it failed.
+fn parse_text<T: DeserializeOwned>(text: &str) -> Result<T, (String, ron::error::SpannedError)> {
+    let mut de = ron::Deserializer::from_str(text).map_err(|e| (String::new(), e))?;
+    let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
+        let path = e.path().to_string();
+        (path, de.span_error(e.into_inner()))
+    })?;
+    de.end().map_err(|e| (String::new(), de.span_error(e)))?;
+    Ok(value)
+}
+
+/// The dotted path of the field a parse error is about: where the parser was (`path`, "."
+/// at the top), and the field the error names, if it is not that place itself.
+fn field_path(path: &str, named: Option<&str>) -> String {
+    let mut parts: Vec<&str> = path.split('.').filter(|p| !p.is_empty() && *p != "?").collect();
+    if let Some(name) = named
+        && parts.last() != Some(&name)
+    {
+        parts.push(name);
+    }
+    parts.join(".")
+}
+
+fn parse_error(file: &Path, path: &str, e: ron::error::SpannedError) -> ConfigError {
     use ron::Error;
-    let field = match &e.code {
-        Error::MissingStructField { field, .. } => (*field).to_owned(),
-        Error::NoSuchStructField { found, .. } => found.clone(),
-        Error::DuplicateStructField { field, .. } => (*field).to_owned(),
-        _ => String::new(),
+    let named = match &e.code {
+        Error::MissingStructField { field, .. } | Error::DuplicateStructField { field, .. } => Some(*field),
+        Error::NoSuchStructField { found, .. } => Some(found.as_str()),
+        _ => None,
     };
+    let field = field_path(path, named);
     let message = match &e.code {
         Error::MissingStructField { .. } => "is missing".to_owned(),
         Error::NoSuchStructField { expected, .. } => {

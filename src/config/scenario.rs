@@ -49,7 +49,7 @@ pub const MAX_CREATURES: u32 = 2_000_000;
 
 impl Validate for Scenario {
     fn validate(&self, v: &mut Validator) {
-        v.positive("duration_s", self.duration_s);
+        v.within("duration_s", self.duration_s, 1e-3, 1e4);
         v.require(
             (30..=2000).contains(&self.tick_hz),
             "tick_hz",

@@ -2,6 +2,10 @@
 
 pub mod step_response;
 
+/// The side of the square court the single-creature experiments and the gait recorder run
+/// in: room for a long run without meeting a wall.
+pub const EXPERIMENT_COURT_M: f32 = 300.0;
+
 use bevy::prelude::*;
 
 use crate::config::SimConfig;

@@ -8,7 +8,10 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::lone_creature;
+use super::{EXPERIMENT_COURT_M, lone_creature};
+
+/// A run starts at least this far inside the experiment's court: 8 s at 3 m/s is 24 m.
+const START_MARGIN_M: f32 = 50.0;
 use crate::config::{ConfigError, SimConfig, Validate, Validator, load_file};
 use crate::creature::{DesiredVelocity, PlanarState};
 use crate::lod::LevelPolicy;
@@ -34,6 +37,10 @@ pub struct VelocityStep {
 impl Validate for StepResponseConfig {
     fn validate(&self, v: &mut Validator) {
         v.positive("duration_s", self.duration_s);
+        // The run must stay in the experiment's court: a start well inside it.
+        let reach = EXPERIMENT_COURT_M / 2.0 - START_MARGIN_M;
+        v.within("start_m.0", self.start_m.0, -reach, reach);
+        v.within("start_m.1", self.start_m.1, -reach, reach);
         v.require(!self.steps.is_empty(), "steps", "must hold at least one step");
         for (i, s) in self.steps.iter().enumerate() {
             v.non_negative(&format!("steps[{i}].at_s"), s.at_s);
@@ -82,7 +89,7 @@ pub fn trace(
     policy: LevelPolicy,
 ) -> Trace {
     let start = Vec2::new(experiment.start_m.0, experiment.start_m.1);
-    let (mut sim, creature) = lone_creature(sim_config, &experiment.creature, policy, start, 300.0);
+    let (mut sim, creature) = lone_creature(sim_config, &experiment.creature, policy, start, EXPERIMENT_COURT_M);
     let mut samples = Vec::new();
     while sim.clock().seconds() < f64::from(experiment.duration_s) {
         let t = sim.clock().seconds() as f32;
@@ -101,7 +108,8 @@ pub fn trace(
     Trace { model, samples }
 }
 
-/// Writes `velocity.csv` (figure 3) and `path.csv` (figure 4) into `out`; returns a summary.
+/// Writes `velocity.csv` (figure 3), `path.csv` (figure 4) and `final.csv` (where each model
+/// ended, and how far apart) into `out`; returns a summary.
 pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result<String, String> {
     let experiment: StepResponseConfig = load_file(experiment_file).map_err(|e: ConfigError| e.to_string())?;
     if sim_config.kind_index(&experiment.creature).is_none() {
@@ -150,16 +158,22 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
         .iter()
         .filter_map(|tr| tr.samples.last().map(|s| s.2.position))
         .collect();
+    let mut last = String::from("rigid_x_m,rigid_z_m,hybrid_x_m,hybrid_z_m,distance_m\n");
     if let [rigid, hybrid] = ends[..] {
+        let apart = rigid.distance(hybrid);
         let _ = writeln!(
             summary,
-            "after {:.1} s the models are {:.3} m apart",
-            experiment.duration_s,
-            rigid.distance(hybrid)
+            "after {:.1} s the models are {apart:.3} m apart",
+            experiment.duration_s
+        );
+        let _ = writeln!(
+            last,
+            "{:.4},{:.4},{:.4},{:.4},{apart:.4}",
+            rigid.x, rigid.y, hybrid.x, hybrid.y
         );
     }
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
-    for (name, text) in [("velocity.csv", &velocity), ("path.csv", &path)] {
+    for (name, text) in [("velocity.csv", &velocity), ("path.csv", &path), ("final.csv", &last)] {
         let file = out.join(name);
         std::fs::write(&file, text).map_err(|e| format!("cannot write {}: {e}", file.display()))?;
         let _ = writeln!(summary, "wrote {}", file.display());

@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use super::{COLUMNS, GaitPose, GaitRow, GaitTable};
 use crate::config::SimConfig;
 use crate::creature::{DesiredVelocity, PlanarState};
-use crate::experiments::lone_creature;
+use crate::experiments::{EXPERIMENT_COURT_M, lone_creature};
 use crate::headless::HeadlessSim;
 use crate::lod::LevelPolicy;
 use crate::models::rigid::{Raibert, RigidHopper, rigid_pose};
@@ -54,7 +54,9 @@ struct Tick {
 fn runner(config: &SimConfig, kind: &str, speed: f32) -> (HeadlessSim, Entity) {
     let mut config = config.clone();
     config.scenario.decision_hz = config.scenario.tick_hz;
-    let (mut sim, hopper) = lone_creature(&config, kind, LevelPolicy::AllRigid, Vec2::new(-140.0, 0.0), 300.0);
+    // From near one wall toward the other: the longest straight run the court allows.
+    let start = Vec2::new(10.0 - EXPERIMENT_COURT_M / 2.0, 0.0);
+    let (mut sim, hopper) = lone_creature(&config, kind, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
     sim.app
         .world_mut()
         .entity_mut(hopper)

@@ -62,7 +62,17 @@ fn a_missing_field_is_named() {
         "creatures/hopper.ron",
         &edited("creatures/hopper.ron", "mass_kg: 10.0,", ""),
     );
-    assert_names(&err, "creatures/hopper.ron", "mass_kg", "missing");
+    assert_names(&err, "creatures/hopper.ron", "body.mass_kg", "missing");
+}
+
+#[test]
+fn a_value_of_the_wrong_type_is_named_by_its_whole_path() {
+    let err = load_error(
+        "wrong_type",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "mass_kg: 10.0,", "mass_kg: \"heavy\","),
+    );
+    assert_names(&err, "creatures/hopper.ron", "body.mass_kg", "line");
 }
 
 #[test]
@@ -109,6 +119,35 @@ fn a_court_smaller_than_the_puck_is_refused() {
         &edited("arena.ron", "court_width_m: 40.0", "court_width_m: 3.0"),
     );
     assert_names(&err, "arena.ron", "puck.radius_m", "does not fit in the court");
+}
+
+#[test]
+fn a_court_too_large_to_index_is_refused() {
+    let err = load_error(
+        "huge_court",
+        "arena.ron",
+        &edited("arena.ron", "court_width_m: 40.0", "court_width_m: 1e6"),
+    );
+    assert_names(&err, "arena.ron", "court_width_m", "at most");
+}
+
+#[test]
+fn a_leg_shorter_than_it_is_thick_is_refused() {
+    let err = load_error(
+        "stub_leg",
+        "creatures/hopper.ron",
+        &edited(
+            "creatures/hopper.ron",
+            "upper_leg_length_m: 0.45",
+            "upper_leg_length_m: 0.05",
+        ),
+    );
+    assert_names(
+        &err,
+        "creatures/hopper.ron",
+        "rigid.upper_leg_length_m",
+        "longer than it is thick",
+    );
 }
 
 #[test]

@@ -38,6 +38,24 @@ fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
             vx_at(model, 3.45)
         );
     }
+    // Figure 4: where the paths end, and how far apart: the last rows of path.csv.
+    let end_of = |model: &str| -> (f32, f32) {
+        let row = path.lines().filter(|l| l.starts_with(model)).last().unwrap();
+        let v: Vec<f32> = row.split(',').skip(2).map(|x| x.parse().unwrap()).collect();
+        (v[0], v[1])
+    };
+    let last = std::fs::read_to_string(out.join("final.csv")).unwrap();
+    let v: Vec<f32> = last
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|x| x.parse().unwrap())
+        .collect();
+    let ((rx, rz), (hx, hz)) = (end_of("rigid"), end_of("hybrid"));
+    assert_eq!((v[0], v[1], v[2], v[3]), (rx, rz, hx, hz), "{last}");
+    let apart = ((rx - hx).powi(2) + (rz - hz).powi(2)).sqrt();
+    assert!((v[4] - apart).abs() < 1e-3 && apart > 0.0, "{last}");
     // Figure 3: the hybrid responds to the step with less delay.
     assert!(
         vx_at("hybrid", 1.5) > vx_at("rigid", 1.5),

@@ -2,6 +2,7 @@
 //! steps.
 
 mod assets;
+mod cli;
 mod court;
 mod determinism;
 mod experiments;

@@ -1,0 +1,80 @@
+//! The headless command line as a user runs it: the binary, its output and exit status.
+
+use std::process::{Command, Output};
+
+fn simlod(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_simlod"))
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("the simlod binary runs")
+}
+
+#[test]
+fn run_json_has_the_keys_of_the_summary() {
+    let out = simlod(&[
+        "run",
+        "--seconds",
+        "2",
+        "--seed",
+        "3",
+        "--policy",
+        "influence",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    for key in [
+        "collisions",
+        "creatures_collided",
+        "respawns",
+        "levels",
+        "levels_mean",
+        "switches",
+        "sim_seconds",
+        "wall_seconds",
+    ] {
+        assert!(summary.get(key).is_some(), "no {key:?} in {summary}");
+    }
+    for kind in ["puck", "wall", "creature"] {
+        assert!(summary["collisions"][kind].is_u64(), "{summary}");
+    }
+    assert_eq!(summary["seed"], 3);
+    assert!((summary["sim_seconds"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+    let creatures = summary["creatures"].as_u64().unwrap();
+    let levels: u64 = summary["levels"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(levels, creatures, "every creature is at one level: {summary}");
+}
+
+/// A user's mistake is one clear message and exit status 2, never a panic.
+fn refused(args: &[&str], says: &str) {
+    let out = simlod(args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+    assert!(stderr.contains(says), "{args:?} should say {says:?}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+}
+
+#[test]
+fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
+    refused(&["run", "--policy", "sometimes"], "sometimes");
+    refused(&["run", "--seconds", "soon"], "soon");
+    refused(&["run", "--seconds", "1e6"], "10000");
+    refused(&["run", "--puck-radius", "-3"], "-3");
+    refused(&["run", "--scenario", "assets/scenarios/nowhere.ron"], "nowhere.ron");
+    refused(
+        &[
+            "record-gait",
+            "--creature",
+            "assets/creatures/hopper.ron",
+            "--speeds",
+            "2,1",
+        ],
+        "--speeds",
+    );
+}
