@@ -52,7 +52,7 @@ impl Validate for ArenaConfig {
         ] {
             v.positive(field, side);
             v.require(
-                !(side > MAX_COURT_SIDE_M),
+                side.is_nan() || side <= MAX_COURT_SIDE_M,
                 field,
                 format!("must be at most {MAX_COURT_SIDE_M} m, got {side}"),
             );

@@ -40,7 +40,7 @@ fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
     }
     // Figure 4: where the paths end, and how far apart: the last rows of path.csv.
     let end_of = |model: &str| -> (f32, f32) {
-        let row = path.lines().filter(|l| l.starts_with(model)).last().unwrap();
+        let row = path.lines().rfind(|l| l.starts_with(model)).unwrap();
         let v: Vec<f32> = row.split(',').skip(2).map(|x| x.parse().unwrap()).collect();
         (v[0], v[1])
     };
