@@ -27,8 +27,10 @@ pub struct LevelBench {
     pub frame_ms_median: f64,
     /// The most creatures whose median frame fits in 1/30 s (within the search's 3 %).
     pub max_creatures_30fps: u32,
-    /// Frames measured per median.
+    /// Frames measured per run.
     pub frames: usize,
+    /// Runs the reference figures are the median of.
+    pub runs: usize,
 }
 
 /// The scenario with `count` creatures of the same mix, in a court grown to the same density.
@@ -52,21 +54,36 @@ pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig 
     c
 }
 
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() / 2]
+}
+
 /// Median frame time in seconds of `config`, after a warm-up.
 pub fn median_frame_seconds(config: SimConfig, warmup: usize, frames: usize) -> f64 {
     let mut sim = HeadlessSim::new(config);
     for _ in 0..warmup {
         sim.advance_frame();
     }
-    let mut times: Vec<f64> = (0..frames)
-        .map(|_| {
-            let start = Instant::now();
-            sim.advance_frame();
-            start.elapsed().as_secs_f64()
-        })
-        .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
+    median(
+        (0..frames)
+            .map(|_| {
+                let start = Instant::now();
+                sim.advance_frame();
+                start.elapsed().as_secs_f64()
+            })
+            .collect(),
+    )
+}
+
+/// The median over `runs` fresh runs of their median frame times: one run's figure moves
+/// with whatever else the machine was doing while it ran.
+fn median_of_runs(config: &SimConfig, runs: usize, warmup: usize, frames: usize) -> f64 {
+    median(
+        (0..runs)
+            .map(|_| median_frame_seconds(config.clone(), warmup, frames))
+            .collect(),
+    )
 }
 
 /// How hard one level is measured.
@@ -77,11 +94,18 @@ struct Effort {
     search_from: u32,
     warmup: usize,
     frames: usize,
+    /// Fresh runs the reference figures are the median of.
+    runs: usize,
     search_steps: u32,
 }
 
 fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Effort) -> LevelBench {
-    let frame_s = median_frame_seconds(scaled(config, effort.reference, policy), effort.warmup, effort.frames);
+    let frame_s = median_of_runs(
+        &scaled(config, effort.reference, policy),
+        effort.runs,
+        effort.warmup,
+        effort.frames,
+    );
     let fits =
         |n: u32| median_frame_seconds(scaled(config, n, policy), effort.warmup / 2, effort.frames) <= FRAME_BUDGET_S;
     // Double until a count misses the budget, then halve the gap.
@@ -104,6 +128,7 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
         frame_ms_median: frame_s * 1e3,
         max_creatures_30fps: good,
         frames: effort.frames,
+        runs: effort.runs,
     }
 }
 
@@ -126,7 +151,7 @@ fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
 /// Runs the benchmark for every level and prints it.
 pub fn run(config: &SimConfig, quick: bool, json: bool) {
     let scale = |full: u32| if quick { (full / 5).max(1) } else { full };
-    let (warmup, frames, search_steps) = if quick { (10, 15, 3) } else { (30, 45, 6) };
+    let (warmup, frames, runs, search_steps) = if quick { (10, 15, 1, 3) } else { (30, 45, 3, 6) };
     let levels = [
         (Lod::PointMass, LevelPolicy::AllPointMass, scale(10_000), 1000),
         (Lod::Hybrid, LevelPolicy::AllHybrid, scale(10_000), 1000),
@@ -134,7 +159,7 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
     ];
     if !json {
         println!(
-            "simlod bench: median of {frames} frames of 1/30 s (medians, one process); court scaled to the scenario's density"
+            "simlod bench: frames of 1/30 s, the median over {runs} runs of each run's median of {frames} frames (the search for the most at 30 fps: one run a count), in one process; court scaled to the scenario's density"
         );
     }
     let mut results = Vec::new();
@@ -144,6 +169,7 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
             search_from,
             warmup,
             frames,
+            runs,
             search_steps,
         };
         let level_config = kinds_with(config, level);
@@ -180,16 +206,16 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
             }
         }
     }
-    game_speedup(config, warmup, frames, json);
+    game_speedup(config, runs, warmup, frames, json);
 }
 
 /// The scenario's own game under the influence policy against the identical game all rigid
 /// (the saving the paper's figure 8 measures).
-fn game_speedup(config: &SimConfig, warmup: usize, frames: usize, json: bool) {
+fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, json: bool) {
     let frame_ms = |policy: LevelPolicy| {
         let mut c = config.clone();
         c.scenario.level_policy = policy;
-        median_frame_seconds(c, warmup, frames) * 1e3
+        median_of_runs(&c, runs, warmup, frames) * 1e3
     };
     let (influence, rigid) = (frame_ms(LevelPolicy::Influence), frame_ms(LevelPolicy::AllRigid));
     let creatures = config.scenario.creature_count();

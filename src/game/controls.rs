@@ -79,14 +79,14 @@ fn read_game_keys(
         ));
     }
     if keys.just_pressed(KeyCode::KeyL) {
-        // Every policy there is, in turn. A policy picks each creature's level when it
-        // spawns, so a new round starts with it (and later rounds keep it).
+        // Every policy there is, in turn, live: each creature moves to its new level in its
+        // next flight window (paper 3.4); later rounds keep the policy.
         let all = LevelPolicy::value_variants();
-        let now = all.iter().position(|&p| p == base.scenario.level_policy).unwrap_or(0);
+        let now = all.iter().position(|&p| p == config.scenario.level_policy).unwrap_or(0);
         let next = all[(now + 1) % all.len()];
+        config.scenario.level_policy = next;
         base.scenario.level_policy = next;
-        rounds.write(NewRound);
-        say(format!("level policy {}: a new round", policy_name(next)));
+        say(format!("level policy {}", policy_name(next)));
     }
     // The puck's radius of influence (figure 8) and the camera's (figure 9), live: the
     // rules decide levels at every decision, so the change shows at once (paper 3.4).
@@ -218,6 +218,34 @@ mod tests {
                 .text
                 .contains("puck radius of influence 0 m")
         );
+    }
+
+    #[test]
+    fn the_policy_key_changes_the_running_policy_without_a_new_round() {
+        let mut app = app_with_keys(LevelPolicy::Combined);
+        let serials = |app: &mut App| {
+            let world = app.world_mut();
+            let mut s: Vec<u32> = world
+                .query::<&crate::creature::Creature>()
+                .iter(world)
+                .map(|c| c.serial)
+                .collect();
+            s.sort_unstable();
+            s
+        };
+        let before = serials(&mut app);
+        press(&mut app, KeyCode::KeyL);
+        let policies = |app: &App| {
+            (
+                app.world().resource::<SimConfig>().scenario.level_policy,
+                app.world().resource::<BaseConfig>().scenario.level_policy,
+            )
+        };
+        assert_eq!(policies(&app), (LevelPolicy::AllPointMass, LevelPolicy::AllPointMass));
+        assert_eq!(serials(&mut app), before, "the same creatures: no new round");
+        press(&mut app, KeyCode::KeyL);
+        assert_eq!(policies(&app), (LevelPolicy::AllHybrid, LevelPolicy::AllHybrid));
+        assert!(app.world().resource::<Notice>().text.contains("all-hybrid"));
     }
 
     #[test]

@@ -168,6 +168,21 @@ fn place_camera(
     };
 }
 
+/// Whether every creature is at the level a fixed policy gives it, so that selecting and
+/// switching can rest. Under a rule-based policy levels keep changing.
+#[derive(Resource, Default)]
+pub struct LevelsSettled(bool);
+
+/// Levels may change: under a rule-based policy always; under a fixed one until every
+/// creature has reached it (at the start, or after the policy changed during a game).
+pub fn levels_may_change(config: Res<SimConfig>, settled: Res<LevelsSettled>) -> bool {
+    config.scenario.level_policy.is_dynamic() || !settled.0
+}
+
+fn unsettle_levels(mut settled: ResMut<LevelsSettled>) {
+    settled.0 = false;
+}
+
 /// At each decision, the level the policy wants for every creature, with hysteresis.
 fn select_levels(
     clock: Res<SimClock>,
@@ -177,6 +192,7 @@ fn select_levels(
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
     camera: Res<SimCamera>,
+    mut settled: ResMut<LevelsSettled>,
     mut creatures: Query<(&Creature, &Lod, &PlanarState, &mut LevelChoice)>,
 ) {
     if !clock.is_decision_tick() {
@@ -222,24 +238,26 @@ fn select_levels(
             choice.wanted = wanted;
         }
     });
+    settled.0 = !policy.is_dynamic() && creatures.iter().all(|(_, lod, _, choice)| *lod == choice.wanted);
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<SimCamera>().add_systems(
-        FixedUpdate,
-        (
-            place_camera.run_if(not(resource_exists::<CameraFromView>)),
-            select_levels,
-        )
-            .chain()
-            .in_set(SimStage::SelectLod)
-            .run_if(dynamic_policy),
-    );
-}
-
-/// Whether the scenario's policy changes levels during the game.
-pub fn dynamic_policy(config: Res<SimConfig>) -> bool {
-    config.scenario.level_policy.is_dynamic()
+    app.init_resource::<SimCamera>()
+        .init_resource::<LevelsSettled>()
+        .add_systems(
+            FixedUpdate,
+            (
+                unsettle_levels.run_if(resource_changed::<SimConfig>),
+                (
+                    place_camera.run_if(not(resource_exists::<CameraFromView>)),
+                    select_levels,
+                )
+                    .chain()
+                    .run_if(levels_may_change),
+            )
+                .chain()
+                .in_set(SimStage::SelectLod),
+        );
 }
 
 #[cfg(test)]

@@ -12,7 +12,7 @@
 use bevy::prelude::*;
 
 use super::Lod;
-use super::select::{LevelChoice, dynamic_policy};
+use super::select::{LevelChoice, levels_may_change};
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::models::rigid::{Raibert, RigidHopper};
@@ -146,7 +146,7 @@ pub(super) fn plugin(app: &mut App) {
         .add_systems(SimStart, reset_switch_tally)
         .add_systems(
             FixedUpdate,
-            switch_levels.in_set(SimStage::Switch).run_if(dynamic_policy),
+            switch_levels.in_set(SimStage::Switch).run_if(levels_may_change),
         )
         .add_systems(FixedUpdate, count_levels.in_set(SimStage::Observe));
 }

@@ -326,3 +326,33 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
     eprintln!("soak: {:?} switches, {} falls", summary.switches, summary.falls);
     assert!(summary.switches["total"] >= 10_000, "{:?}", summary.switches);
 }
+
+#[test]
+fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests() {
+    let mut sim = watched(influence_config());
+    sim.run_for(3.0);
+    let changed_at = sim.clock().seconds() as f32;
+    sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = LevelPolicy::AllPointMass;
+    sim.run_for(3.0);
+    let levels = |sim: &mut HeadlessSim| {
+        let world = sim.app.world_mut();
+        world.query::<&Lod>().iter(world).copied().collect::<Vec<_>>()
+    };
+    assert!(
+        levels(&mut sim).iter().all(|l| *l == Lod::PointMass),
+        "{:?}",
+        levels(&mut sim)
+    );
+    let seen = &sim.app.world().resource::<Watch>().seen;
+    let after: Vec<_> = seen.iter().filter(|o| o.switch.at_s >= changed_at).collect();
+    assert!(after.len() >= 20, "{} switches after the change", after.len());
+    for o in &after {
+        assert_eq!(o.switch.to, Lod::PointMass, "{:?}", o.switch);
+        assert!(o.switch.flight_progress.is_some(), "{:?} skipped the window", o.switch);
+    }
+    // Settled: nothing left to select or switch.
+    let switches = seen.len();
+    sim.run_for(2.0);
+    assert_eq!(sim.app.world().resource::<Watch>().seen.len(), switches);
+    assert!(levels(&mut sim).iter().all(|l| *l == Lod::PointMass));
+}
