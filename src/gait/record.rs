@@ -27,6 +27,12 @@ pub struct RecordSettings {
     pub settle_s: f32,
     /// Hops averaged per speed.
     pub hops: usize,
+    /// The hops are steady when their periods differ by at most this share of their mean,
+    /// and their mean speeds by at most `steady_speed_m_per_s`.
+    pub steady_period_share: f32,
+    pub steady_speed_m_per_s: f32,
+    /// Running time after `settle_s` within which the hops must become steady.
+    pub steady_within_s: f32,
     pub sample_hz: f32,
 }
 
@@ -36,6 +42,9 @@ impl Default for RecordSettings {
             speeds_m_per_s: vec![0.0, 1.0, 2.0, 3.0],
             settle_s: 15.0,
             hops: 4,
+            steady_period_share: 0.05,
+            steady_speed_m_per_s: 0.1,
+            steady_within_s: 10.0,
             sample_hz: 30.0,
         }
     }
@@ -82,31 +91,52 @@ fn sample(sim: &mut HeadlessSim, hopper: Entity) -> Result<(Tick, f32), String> 
     Ok((tick, raibert.last_touchdown_s))
 }
 
-/// Records `hops` steady hops at `speed` and averages them into a row.
+/// How unsteady a run of hops is: the spread of their periods as a share of the mean, and
+/// the spread of their mean speeds.
+fn unsteadiness(hops: &[(f32, f32)], ticks: &[Tick]) -> (f32, f32) {
+    let at = |t: f32| ticks.iter().find(|tk| tk.t >= t).map_or(Vec2::ZERO, |tk| tk.position);
+    let periods: Vec<f32> = hops.iter().map(|(a, b)| b - a).collect();
+    let speeds: Vec<f32> = hops.iter().map(|&(a, b)| (at(b) - at(a)).length() / (b - a)).collect();
+    let spread = |v: &[f32]| v.iter().copied().fold(f32::MIN, f32::max) - v.iter().copied().fold(f32::MAX, f32::min);
+    let mean = periods.iter().sum::<f32>() / periods.len() as f32;
+    (spread(&periods) / mean, spread(&speeds))
+}
+
+/// Records `hops` steady hops at `speed` and averages them into a row: after settling, the
+/// last `hops` hops, once they are steady.
 fn record_row(config: &SimConfig, kind: &str, speed: f32, s: &RecordSettings) -> Result<GaitRow, String> {
     let (mut sim, hopper) = runner(config, kind, speed);
     sim.run_for(f64::from(s.settle_s));
     let mut ticks: Vec<Tick> = Vec::new();
     let mut touchdowns: Vec<f32> = Vec::new();
     let (_, mut last) = sample(&mut sim, hopper)?;
-    while touchdowns.len() <= s.hops {
+    let hops = loop {
         sim.advance_frame();
         let (tick, touchdown) = sample(&mut sim, hopper)?;
-        if touchdown != last {
+        let touched_down = touchdown != last;
+        if touched_down {
             touchdowns.push(touchdown);
             last = touchdown;
         }
         if !touchdowns.is_empty() {
             ticks.push(tick);
         }
-        if sim.clock().seconds() > f64::from(s.settle_s) + 10.0 {
+        if touched_down && touchdowns.len() > s.hops {
+            let recent = &touchdowns[touchdowns.len() - s.hops - 1..];
+            let hops: Vec<(f32, f32)> = recent.windows(2).map(|w| (w[0], w[1])).collect();
+            let (period_share, speed_spread) = unsteadiness(&hops, &ticks);
+            if period_share <= s.steady_period_share && speed_spread <= s.steady_speed_m_per_s {
+                break hops;
+            }
+        }
+        if sim.clock().seconds() > f64::from(s.settle_s + s.steady_within_s) {
             return Err(format!(
-                "no steady hopping at {speed} m/s: {} touchdowns in 10 s",
+                "no steady hopping at {speed} m/s within {} s: {} touchdowns",
+                s.steady_within_s,
                 touchdowns.len()
             ));
         }
-    }
-    let hops: Vec<(f32, f32)> = touchdowns.windows(2).map(|w| (w[0], w[1])).collect();
+    };
     let period = hops.iter().map(|(a, b)| b - a).sum::<f32>() / hops.len() as f32;
     let n = (period * s.sample_hz).ceil() as usize;
     let mut sums = vec![[0.0f32; 6]; n];
