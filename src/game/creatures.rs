@@ -168,14 +168,10 @@ fn pose_from_gait(
             continue;
         }
         let body_radius = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
-        // The inverse of `rigid_pose`: rapier's body frame (x forward, y up, z to the side),
-        // yawed to the heading, then pitched and rolled.
-        let yaw = -state.heading.y.atan2(state.heading.x);
-        let rotation = Quat::from_euler(EulerRot::YZX, yaw, gait.pitch_rad, gait.roll_rad);
+        // Posed as the rigid level would stand in it (`rigid_pose` read backwards).
+        let rotation = gait.body_rotation(state.heading);
         let centre = Vec3::new(state.position.x, gait.body_height_m, state.position.y);
-        let leg = rotation
-            * Vec3::new(gait.leg_forward_rad.tan(), -1.0, -gait.leg_sideways_rad.tan()).normalize()
-            * gait.leg_length_m;
+        let leg = rotation * gait.leg_direction() * gait.leg_length_m;
         let side = rotation * Vec3::Z * body_radius * 0.5;
         let hips: &[Vec3] = if visual.legs.len() == 2 {
             &[centre - side, centre + side]

@@ -178,8 +178,9 @@ pub fn rigid_pose(body: &Transform, foot: &Transform) -> GaitPose {
     }
 }
 
-/// The pose a creature enters the rigid level in (paper 3.4: the motion continues): the
-/// gait table's for its speed and hop phase where its kind has one, else upright at the
+/// The pose a creature enters the rigid level in (paper 3.4: the motion continues): in
+/// flight, the gait table's for its speed and hop phase where its kind has one; else (no
+/// table, or on the ground: a new creature, or a switch forced by a collision) upright at the
 /// height its level last had; the hip raised if need be so the foot starts clear of the
 /// ground. Also the body's vertical velocity, from the table's change of height over the hop.
 fn entry_pose(
@@ -191,14 +192,15 @@ fn entry_pose(
 ) -> (GaitPose, RigidStart) {
     let speed = state.velocity.length();
     let (mut pose, climb) = match &kind.gait {
-        Some(table) => {
+        // In flight, as a switch in the flight window is; the controller starts in flight.
+        Some(table) if gait.in_flight => {
             let (period, _) = table.rhythm(speed);
             let step = 1.0 / (table.sample_hz * period);
             let (now, next) = (table.pose(speed, gait.cycle), table.pose(speed, gait.cycle + step));
             (now, (next.body_height_m - now.body_height_m) * table.sample_hz)
         }
-        // Without a table: the body where the lower level had it, the leg hanging at rest.
-        None => (
+        // Else the body where the lower level had it, the leg hanging at rest.
+        _ => (
             GaitPose {
                 body_height_m: last.body_height_m,
                 leg_length_m: r.leg_rest_length_m,
