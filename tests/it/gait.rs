@@ -166,7 +166,11 @@ fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
     for speed in [0.0, 1.5, 2.0, 2.8] {
         let gap = pose_gap(speed);
         for (i, (column, limit)) in COLUMNS.iter().zip(limits).enumerate() {
-            let g = if column.ends_with("_rad") { gap[i].to_degrees() } else { gap[i] };
+            let g = if column.ends_with("_rad") {
+                gap[i].to_degrees()
+            } else {
+                gap[i]
+            };
             eprintln!("{speed} m/s: largest gap in {column}: {g:.4}");
             assert!(g < limit, "{speed} m/s: {column} off by {g} (limit {limit})");
         }
