@@ -148,8 +148,8 @@ fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
     c
 }
 
-/// Runs the benchmark for every level and prints it.
-pub fn run(config: &SimConfig, quick: bool, json: bool) {
+/// Runs the benchmark for every level (or `only` one) and prints it.
+pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
     let scale = |full: u32| if quick { (full / 5).max(1) } else { full };
     let (warmup, frames, runs, search_steps) = if quick { (10, 15, 1, 3) } else { (30, 45, 3, 6) };
     let levels = [
@@ -163,7 +163,7 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
         );
     }
     let mut results = Vec::new();
-    for (level, policy, reference, search_from) in levels {
+    for (level, policy, reference, search_from) in levels.into_iter().filter(|l| only.is_none_or(|o| o == l.0)) {
         let effort = Effort {
             reference,
             search_from,
@@ -206,7 +206,9 @@ pub fn run(config: &SimConfig, quick: bool, json: bool) {
             }
         }
     }
-    game_speedup(config, runs, warmup, frames, json);
+    if only.is_none() {
+        game_speedup(config, runs, warmup, frames, json);
+    }
 }
 
 /// The scenario's own game under the influence policy against the identical game all rigid

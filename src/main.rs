@@ -7,7 +7,7 @@ use std::process::ExitCode;
 
 use simlod::config::{CreatureDef, CreatureGroup, SimConfig, Validate, Validator, load_file};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
-use simlod::lod::LevelPolicy;
+use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::Summary;
 use simlod::{bench, experiments, headless};
 
@@ -258,6 +258,9 @@ struct BenchArgs {
     /// Fewer, shorter repetitions: a rough figure in seconds.
     #[arg(long)]
     quick: bool,
+    /// Only this level (no cost ratios, no game).
+    #[arg(long, value_enum)]
+    level: Option<Lod>,
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
@@ -326,7 +329,7 @@ fn main() -> ExitCode {
         Some(Command::Bench(args)) => args
             .scenario
             .load()
-            .map(|config| bench::run(&config, args.quick, args.json)),
+            .map(|config| bench::run(&config, args.quick, args.json, args.level)),
         Some(Command::Experiment(ExperimentArgs {
             which:
                 ExperimentKind::StepResponse {

@@ -15,7 +15,21 @@ use serde::{Deserialize, Serialize};
 
 /// The level of detail a creature is simulated at; ordered from the cheapest to the most
 /// detailed.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Component,
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    Serialize,
+    Deserialize,
+    clap::ValueEnum,
+)]
 pub enum Lod {
     /// A point mass on the plane with an acceleration limit; the leg held at a constant
     /// angle (section 3.3).
