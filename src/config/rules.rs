@@ -10,6 +10,8 @@ pub struct LevelRules {
     pub influence: InfluenceRules,
     pub camera: CameraRules,
     pub release_margin_m: f32,
+    /// To leave the camera's view a creature must be this much further outside its cone.
+    pub release_margin_deg: f32,
     pub min_dwell_s: f32,
     /// Start and end of the switching window, as parts of the flight phase.
     pub flight_window: (f32, f32),
@@ -48,6 +50,7 @@ impl Validate for LevelRules {
             v.non_negative("follow_distance_m", self.camera.follow_distance_m);
         });
         v.non_negative("release_margin_m", self.release_margin_m);
+        v.within("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
         v.non_negative("min_dwell_s", self.min_dwell_s);
         let (a, b) = self.flight_window;
         v.within("flight_window.0", a, 0.0, 1.0);

@@ -65,21 +65,30 @@ pub fn in_influence(q: Vec2, p: Vec2, v: Vec2, radius: f32, lookahead_s: f32) ->
     x * x + y * y <= 1.0
 }
 
-/// Radii grown by `grow` metres (the hysteresis margin when deciding whether to stay).
+/// The areas' radii and the view cone, to enter them or, grown by the release margins, to
+/// stay in them (the hysteresis).
 struct Radii {
     puck: f32,
     creature: f32,
     wall: f32,
     camera: f32,
+    /// Cosine of the view cone's half angle.
+    view_cos: f32,
 }
 
 impl Radii {
-    fn of(rules: &LevelRules, grow: f32) -> Self {
+    fn of(rules: &LevelRules, half_view_rad: f32, staying: bool) -> Self {
+        let (grow, turn) = if staying {
+            (rules.release_margin_m, rules.release_margin_deg.to_radians())
+        } else {
+            (0.0, 0.0)
+        };
         Self {
             puck: rules.influence.puck_radius_m + grow,
             creature: rules.influence.creature_radius_m + grow,
             wall: rules.influence.wall_band_m + grow,
             camera: rules.camera.radius_m + grow,
+            view_cos: (half_view_rad + turn).min(std::f32::consts::PI).cos(),
         }
     }
 }
@@ -91,7 +100,6 @@ struct LevelInputs<'a> {
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
     reach_m: f32,
-    half_view_cos: f32,
 }
 
 impl LevelInputs<'_> {
@@ -121,7 +129,7 @@ impl LevelInputs<'_> {
     fn camera_level(&self, s: &PlanarState, r: &Radii) -> Lod {
         let to = s.position - self.camera.position;
         let distance = to.length();
-        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.half_view_cos;
+        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * r.view_cos;
         match (in_view, distance <= r.camera) {
             (false, _) => Lod::PointMass,
             (true, false) => Lod::Hybrid,
@@ -208,9 +216,11 @@ fn select_levels(
         grid: &grid,
         camera: &camera,
         reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
-        half_view_cos: camera.half_view_rad.cos(),
     };
-    let (enter, leave) = (Radii::of(rules, 0.0), Radii::of(rules, rules.release_margin_m));
+    let (enter, leave) = (
+        Radii::of(rules, camera.half_view_rad, false),
+        Radii::of(rules, camera.half_view_rad, true),
+    );
     let now = clock.seconds() as f32;
     for_each_creature!(config.scenario.creature_count(), creatures, |(
         c,

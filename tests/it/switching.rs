@@ -356,3 +356,40 @@ fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests()
     assert_eq!(sim.app.world().resource::<Watch>().seen.len(), switches);
     assert!(levels(&mut sim).iter().all(|l| *l == Lod::PointMass));
 }
+
+#[test]
+fn a_margin_at_the_edge_of_the_view_cone_keeps_creatures_there_from_flickering() {
+    // The camera rule alone, no dwell and no distance margin: only the cone's margin holds.
+    // A flicker is a creature going into view and back out (or out and back in) within a
+    // second, two hops.
+    let flickers = |margin_deg: f32| {
+        let mut config = default_config();
+        config.scenario.level_policy = LevelPolicy::Camera;
+        config.rules.min_dwell_s = 0.0;
+        config.rules.release_margin_m = 0.0;
+        config.rules.release_margin_deg = margin_deg;
+        let mut sim = watched(config);
+        sim.run_for(20.0);
+        let mut last: HashMap<u32, LevelSwitched> = HashMap::new();
+        let mut count = 0;
+        for o in &sim.app.world().resource::<Watch>().seen {
+            let s = o.switch;
+            let across_edge = |a: Lod, b: Lod| a.min(b) == Lod::PointMass && a != b;
+            if let Some(p) = last.get(&s.serial)
+                && across_edge(s.from, s.to)
+                && (p.from, p.to) == (s.to, s.from)
+                && s.at_s - p.at_s < 1.0
+            {
+                count += 1;
+            }
+            last.insert(s.serial, s);
+        }
+        count
+    };
+    let (without, with) = (flickers(0.0), flickers(10.0));
+    eprintln!("flickers across the view's edge: {without} without a margin, {with} with 10 degrees");
+    assert!(
+        with * 2 < without,
+        "flickers across the view's edge: {without} without a margin, {with} with 10 degrees"
+    );
+}
