@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use simlod::config::{CreatureDef, CreatureGroup, SimConfig, Validate, Validator, load_file};
+use simlod::config::{CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_file};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::Summary;
@@ -265,11 +265,12 @@ struct BenchArgs {
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
-    // The models keep time in f32 seconds: past 1e4 s its steps grow toward a tick's length.
-    if v.is_finite() && v > 0.0 && v <= 1e4 {
+    if v.is_finite() && v > 0.0 && v <= f64::from(MAX_DURATION_S) {
         Ok(v)
     } else {
-        Err(format!("must be more than 0 and at most 10000 seconds, got {v}"))
+        Err(format!(
+            "must be more than 0 and at most {MAX_DURATION_S} seconds, got {v}"
+        ))
     }
 }
 

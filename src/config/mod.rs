@@ -17,7 +17,7 @@ pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConf
 pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{CameraRules, InfluenceRules, LevelRules};
-pub use scenario::{CreatureGroup, MAX_CREATURES, Scenario};
+pub use scenario::{CreatureGroup, MAX_CREATURES, MAX_DURATION_S, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator};
 
 use bevy::prelude::*;

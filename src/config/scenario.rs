@@ -47,9 +47,13 @@ impl Scenario {
 /// Most creatures a scenario may hold.
 pub const MAX_CREATURES: u32 = 2_000_000;
 
+/// The longest run: the models keep time in f32 seconds, and past this their steps grow
+/// toward a tick's length.
+pub const MAX_DURATION_S: f32 = 10_000.0;
+
 impl Validate for Scenario {
     fn validate(&self, v: &mut Validator) {
-        v.within("duration_s", self.duration_s, 1e-3, 1e4);
+        v.within("duration_s", self.duration_s, 1e-3, MAX_DURATION_S);
         v.require(
             (30..=2000).contains(&self.tick_hz),
             "tick_hz",

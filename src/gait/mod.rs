@@ -74,6 +74,11 @@ impl GaitPose {
         Vec3::new(self.leg_forward_rad.tan(), -1.0, -self.leg_sideways_rad.tan()).normalize()
     }
 
+    /// The leg's rotation at the hip from hanging straight down, in the body's frame.
+    pub fn hip_rotation(&self) -> Quat {
+        Quat::from_rotation_arc(Vec3::NEG_Y, self.leg_direction())
+    }
+
     fn lerp(self, other: Self, t: f32) -> Self {
         let (a, b) = (self.to_row(), other.to_row());
         Self::from_row(&std::array::from_fn::<f32, 6, _>(|i| a[i] + (b[i] - a[i]) * t))

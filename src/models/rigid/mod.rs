@@ -104,7 +104,7 @@ pub fn spawn_hopper(
     pose: &GaitPose,
 ) -> RigidHopper {
     let body_rotation = pose.body_rotation(state.heading);
-    let leg_rotation = body_rotation * Quat::from_rotation_arc(Vec3::NEG_Y, pose.leg_direction());
+    let leg_rotation = body_rotation * pose.hip_rotation();
     let hip = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
     let foot = hip + leg_rotation * Vec3::NEG_Y * pose.leg_length_m;
     let (hx, hy, hz) = r.body_half_extents_m;
@@ -216,7 +216,7 @@ fn entry_pose(
         .body_height_m
         .max(foot_drop + r.foot_radius_m + FOOT_START_CLEARANCE_M);
     let start = RigidStart {
-        hip_rotation: Quat::from_rotation_arc(Vec3::NEG_Y, pose.leg_direction()).to_scaled_axis(),
+        hip_rotation: pose.hip_rotation().to_scaled_axis(),
         leg_extension_m: pose.leg_length_m - r.leg_rest_length_m,
         velocity: Vec3::new(state.velocity.x, climb, state.velocity.y),
     };
