@@ -10,6 +10,7 @@ use serde::Serialize;
 use std::time::Instant;
 
 use crate::config::SimConfig;
+use crate::creature::KindTable;
 use crate::headless::HeadlessSim;
 use crate::lod::{LevelPolicy, Lod};
 
@@ -19,7 +20,8 @@ const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
 /// What `simlod bench --json` prints, one object per level.
 #[derive(Clone, Debug, Serialize)]
 pub struct LevelBench {
-    pub level: &'static str,
+    #[serde(serialize_with = "level_name")]
+    pub level: Lod,
     /// Median wall time per creature per 1/30 s of motion, at `reference_creatures`.
     pub us_per_creature_per_frame: f64,
     pub reference_creatures: u32,
@@ -31,6 +33,10 @@ pub struct LevelBench {
     pub frames: usize,
     /// Runs the reference figures are the median of.
     pub runs: usize,
+}
+
+fn level_name<S: serde::Serializer>(level: &Lod, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(level.name())
 }
 
 /// The scenario with `count` creatures of the same mix, in a court grown to the same density.
@@ -122,7 +128,7 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
         if fits(mid) { good = mid } else { bad = mid }
     }
     LevelBench {
-        level: level.name(),
+        level,
         us_per_creature_per_frame: frame_s * 1e6 / f64::from(effort.reference),
         reference_creatures: effort.reference,
         frame_ms_median: frame_s * 1e3,
@@ -134,16 +140,12 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
 
 /// The scenario with only the kinds that have a model at `level`.
 fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
+    let kinds = KindTable::of(config);
     let mut c = config.clone();
     c.scenario.creatures.retain(|g| {
-        let kind = config
+        config
             .kind_index(&g.kind)
-            .expect("kinds are resolved when the config loads");
-        match level {
-            Lod::PointMass => true,
-            Lod::Hybrid => config.gaits[kind].is_some(),
-            Lod::Rigid => config.kinds[kind].rigid.is_some(),
-        }
+            .is_some_and(|kind| kinds[kind].levels.contains(&level))
     });
     c
 }
@@ -182,19 +184,24 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
         } else {
             println!(
                 "{:<11} {:>9.3} us per creature per frame ({:.2} ms a frame at {}); most creatures at 30 fps: {}",
-                b.level, b.us_per_creature_per_frame, b.frame_ms_median, b.reference_creatures, b.max_creatures_30fps
+                b.level.name(),
+                b.us_per_creature_per_frame,
+                b.frame_ms_median,
+                b.reference_creatures,
+                b.max_creatures_30fps
             );
         }
         results.push(b);
     }
-    let cost = |level: &str| {
+    let cost = |level: Lod| {
         results
             .iter()
             .find(|b| b.level == level)
             .map(|b| b.us_per_creature_per_frame)
     };
-    for cheaper in ["hybrid", "point_mass"] {
-        if let (Some(rigid), Some(cheap)) = (cost("rigid"), cost(cheaper)) {
+    for cheaper in [Lod::Hybrid, Lod::PointMass] {
+        if let (Some(rigid), Some(cheap)) = (cost(Lod::Rigid), cost(cheaper)) {
+            let cheaper = cheaper.name();
             let ratio = rigid / cheap;
             if json {
                 println!(

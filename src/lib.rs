@@ -46,6 +46,7 @@ pub mod lod;
 pub mod models;
 pub mod outcome;
 pub mod sense;
+pub mod third_party;
 
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
@@ -114,7 +115,7 @@ pub struct SimPlugin {
 }
 
 /// The resources a run starts from: the config, its seeded RNG, a clock at tick 0, and the
-/// fixed timestep (rapier reads its own copy).
+/// fixed timestep (rapier keeps its own copy).
 fn insert_run_resources(world: &mut World, config: SimConfig) {
     let scenario = &config.scenario;
     let dt = 1.0 / scenario.tick_hz as f32;
@@ -126,7 +127,7 @@ fn insert_run_resources(world: &mut World, config: SimConfig) {
         ticks_per_decision: scenario.ticks_per_decision(),
     });
     world.insert_resource(Time::<Fixed>::from_seconds(f64::from(dt)));
-    world.insert_resource(TimestepMode::Fixed { dt, substeps: 1 });
+    third_party::rapier::set_timestep(world, dt);
     world.insert_resource(config);
 }
 
@@ -138,29 +139,9 @@ pub fn start_over(world: &mut World, config: SimConfig) {
     for entity in old {
         world.despawn(entity);
     }
-    empty_physics(world);
+    third_party::rapier::empty_world(world);
     insert_run_resources(world, config);
     world.run_schedule(SimStart);
-}
-
-/// Empties rapier's world rather than letting it remove the old bodies one by one: freed
-/// handles would be reused in another order, and with them the solver's order, so a new
-/// round would not match a fresh start with the same seed.
-fn empty_physics(world: &mut World) {
-    let mut contexts = world.query::<(
-        &mut RapierContextSimulation,
-        &mut RapierContextColliders,
-        &mut RapierRigidBodySet,
-        &mut RapierContextJoints,
-    )>();
-    for (mut simulation, mut colliders, mut bodies, mut joints) in contexts.iter_mut(world) {
-        let parameters = simulation.integration_parameters;
-        *simulation = default();
-        simulation.integration_parameters = parameters;
-        *colliders = default();
-        *bodies = default();
-        *joints = default();
-    }
 }
 
 fn run_sim_start(world: &mut World) {
@@ -173,8 +154,8 @@ impl Plugin for SimPlugin {
             app.add_plugins(TransformPlugin);
         }
         insert_run_resources(app.world_mut(), self.config.clone());
-        app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
-            .init_schedule(SimStart)
+        third_party::plugin(app);
+        app.init_schedule(SimStart)
             .add_systems(Startup, run_sim_start)
             .configure_sets(
                 FixedUpdate,

@@ -8,7 +8,7 @@ use std::process::ExitCode;
 use simlod::config::{CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_file};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::{LevelPolicy, Lod};
-use simlod::outcome::Summary;
+use simlod::outcome::{Counts, Key, Summary};
 use simlod::{bench, experiments, headless};
 
 #[derive(Parser)]
@@ -56,8 +56,8 @@ struct RecordGaitArgs {
 
 impl RecordGaitArgs {
     fn run(&self) -> Result<(), String> {
-        let mut config = self.scenario.load()?;
         let def: CreatureDef = load_file(&self.creature).map_err(|e| e.to_string())?;
+        let mut config = self.scenario.load_without_table_of(Some(&def.name))?;
         if def.rigid.is_none() {
             return Err(format!(
                 "{}: the creature has no `rigid` section to record from",
@@ -186,7 +186,14 @@ fn non_negative_metres(s: &str) -> Result<f32, String> {
 
 impl ScenarioArgs {
     fn load(&self) -> Result<SimConfig, String> {
-        let mut config = SimConfig::load(&self.scenario, &self.assets).map_err(|e| e.to_string())?;
+        self.load_without_table_of(None)
+    }
+
+    /// The scenario with its overrides; kind `without` gets no gait table (see
+    /// [`SimConfig::load_without_table_of`]).
+    fn load_without_table_of(&self, without: Option<&str>) -> Result<SimConfig, String> {
+        let mut config =
+            SimConfig::load_without_table_of(&self.scenario, &self.assets, without).map_err(|e| e.to_string())?;
         if let Some(seed) = self.seed {
             config.scenario.seed = seed;
         }
@@ -275,9 +282,13 @@ fn positive_seconds(s: &str) -> Result<f64, String> {
 }
 
 fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
-    let join = |m: &std::collections::BTreeMap<&str, u64>| {
-        m.iter().map(|(k, v)| format!("{k} {v}")).collect::<Vec<_>>().join(", ")
-    };
+    fn join<K: Key, T: std::fmt::Display + Copy>(counts: &Counts<K, T>) -> String {
+        counts
+            .iter()
+            .map(|(k, v)| format!("{} {v}", k.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
     println!(
         "simlod run: {}, seed {}, {} creatures",
         args.scenario.scenario.display(),
@@ -298,10 +309,15 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
     let mean: Vec<String> = s
         .levels_mean
         .iter()
-        .map(|(k, v)| format!("{k} {v:.1} (peak {})", s.levels_peak[k]))
+        .map(|(k, v)| format!("{} {v:.1} (peak {})", k.name(), s.levels_peak[k]))
         .collect();
     println!("creatures per level on average: {}", mean.join(", "));
-    let switches: Vec<String> = s.switches.iter().map(|(k, v)| format!("{k} {v}")).collect();
+    let switches: Vec<String> = s
+        .switches
+        .directions()
+        .map(|(from, to, n)| format!("{}->{} {n}", from.name(), to.name()))
+        .chain([format!("total {}", s.switches.total())])
+        .collect();
     println!("level switches: {}", switches.join(", "));
 }
 

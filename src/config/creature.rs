@@ -4,6 +4,9 @@ use super::{Validate, Validator};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// The most legs a kind may have (the pose keeps them in a fixed array: no allocation per tick).
+pub const MAX_LEGS: usize = 4;
+
 /// One kind of legged creature (the one-legged hopper, the biped, or a modder's own).
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -29,6 +32,11 @@ pub struct CreatureDef {
     /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop).
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
+    /// The legs (at least one, at most [`MAX_LEGS`]): drawn at every level, simulated at the
+    /// rigid one.
+    pub legs: Vec<LegConfig>,
+    /// How the legs share the ground.
+    pub stance: Stance,
     /// The rigid-body model (paper 3.1); a kind without one is never simulated rigid.
     #[serde(default)]
     pub rigid: Option<RigidConfig>,
@@ -38,26 +46,56 @@ pub struct CreatureDef {
     pub gait_table: Option<String>,
 }
 
-/// The rigid-body hopper of the paper's figure 2: a body, an upper leg on a three-axis hip
-/// at the body's centre, and a lower leg with a ball foot on a springy prismatic joint.
+/// One leg, from its hip on the body to its ball foot (paper figure 2): an upper leg on a
+/// three-axis hip, and a lower leg that telescopes on a springy prismatic joint.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LegConfig {
+    /// Where the hip sits, from the body's centre: x forward, y up, z to the right.
+    pub hip_m: (f32, f32, f32),
+    pub upper_length_m: f32,
+    pub upper_mass_kg: f32,
+    /// Foot included.
+    pub lower_length_m: f32,
+    pub lower_mass_kg: f32,
+    pub radius_m: f32,
+    pub foot_radius_m: f32,
+    pub foot_friction: f32,
+    /// Hip to foot centre with the spring at rest.
+    pub rest_length_m: f32,
+    /// Hip to foot centre at the joint's stop.
+    pub min_length_m: f32,
+    pub spring_n_per_m: f32,
+    pub damping_n_s_per_m: f32,
+}
+
+/// How a kind's legs share the ground (Raibert, Legged Robots That Balance, ch. 4-5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Stance {
+    /// Every leg in stance at once: the one-legged hopper.
+    #[default]
+    Together,
+    /// The legs take turns, one stance per step: a biped's run ("one-foot" running).
+    Alternating,
+}
+
+impl Stance {
+    /// Steps in one stride of `legs` legs: the gait table records a whole stride.
+    pub fn steps_per_stride(self, legs: usize) -> u32 {
+        match self {
+            Stance::Together => 1,
+            Stance::Alternating => legs.max(1) as u32,
+        }
+    }
+}
+
+/// The rigid-body model (paper 3.1): the body box on the kind's legs, its controller and
+/// when it has fallen.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidConfig {
     /// Half extents of the body box: x forward, y up, z to the side. Its mass is `body.mass_kg`.
     pub body_half_extents_m: (f32, f32, f32),
-    pub upper_leg_length_m: f32,
-    pub upper_leg_mass_kg: f32,
-    pub lower_leg_length_m: f32,
-    pub lower_leg_mass_kg: f32,
-    pub leg_radius_m: f32,
-    pub foot_radius_m: f32,
-    pub foot_friction: f32,
-    /// Hip to foot centre with the spring at rest.
-    pub leg_rest_length_m: f32,
-    /// Hip to foot centre at the joint's stop.
-    pub leg_min_length_m: f32,
-    pub leg_spring_n_per_m: f32,
-    pub leg_damping_n_s_per_m: f32,
     pub controller: RaibertConfig,
     pub fall: FallConfig,
 }
@@ -91,6 +129,9 @@ pub struct RaibertConfig {
     pub yaw_kd_nm_s_per_rad: f32,
     /// Largest yaw torque the foot's grip on the ground can take.
     pub yaw_max_torque_nm: f32,
+    /// Legs in turn: how much an idle leg is shortened below its rest length to clear the
+    /// ground while it swings to its next touchdown.
+    pub idle_leg_retract_m: f32,
     /// Largest yaw error acted on at once, so a reversal turns smoothly, not violently.
     pub max_yaw_error_rad: f32,
     /// Below this desired speed the body keeps its heading.
@@ -169,8 +210,16 @@ impl Validate for CreatureDef {
         v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
         v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);
         v.within("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        v.require(
+            (1..=MAX_LEGS).contains(&self.legs.len()),
+            "legs",
+            format!("a creature has 1 to {MAX_LEGS} legs, got {}", self.legs.len()),
+        );
+        for (i, leg) in self.legs.iter().enumerate() {
+            v.nested(&format!("legs[{i}]"), |v| leg.validate(v));
+        }
         if let Some(r) = &self.rigid {
-            v.nested("rigid", |v| r.validate(v));
+            v.nested("rigid", |v| r.validate_on(&self.legs, v));
         }
         let s = &self.steering;
         v.nested("steering", |v| {
@@ -192,38 +241,52 @@ impl Validate for CreatureDef {
     }
 }
 
-impl Validate for RigidConfig {
+impl Validate for LegConfig {
     fn validate(&self, v: &mut Validator) {
+        let (x, y, z) = self.hip_m;
+        for (i, e) in [x, y, z].into_iter().enumerate() {
+            v.within(&format!("hip_m.{i}"), e, -5.0, 5.0);
+        }
+        v.positive("upper_length_m", self.upper_length_m);
+        v.positive("upper_mass_kg", self.upper_mass_kg);
+        v.positive("lower_length_m", self.lower_length_m);
+        v.positive("lower_mass_kg", self.lower_mass_kg);
+        v.positive("radius_m", self.radius_m);
+        v.positive("foot_radius_m", self.foot_radius_m);
+        v.non_negative("foot_friction", self.foot_friction);
+        v.positive("rest_length_m", self.rest_length_m);
+        v.positive("min_length_m", self.min_length_m);
+        v.positive("spring_n_per_m", self.spring_n_per_m);
+        v.non_negative("damping_n_s_per_m", self.damping_n_s_per_m);
+        v.require(
+            self.min_length_m < self.rest_length_m,
+            "min_length_m",
+            format!("must be below rest_length_m ({})", self.rest_length_m),
+        );
+        v.require(
+            self.upper_length_m > 2.0 * self.radius_m && self.lower_length_m > self.foot_radius_m,
+            "upper_length_m",
+            "each leg part must be longer than it is thick: upper_length_m above twice radius_m, lower_length_m above foot_radius_m",
+        );
+    }
+}
+
+impl RigidConfig {
+    fn validate_on(&self, legs: &[LegConfig], v: &mut Validator) {
         let (x, y, z) = self.body_half_extents_m;
         for (i, e) in [x, y, z].into_iter().enumerate() {
             v.positive(&format!("body_half_extents_m.{i}"), e);
         }
-        v.positive("upper_leg_length_m", self.upper_leg_length_m);
-        v.positive("upper_leg_mass_kg", self.upper_leg_mass_kg);
-        v.positive("lower_leg_length_m", self.lower_leg_length_m);
-        v.positive("lower_leg_mass_kg", self.lower_leg_mass_kg);
-        v.positive("leg_radius_m", self.leg_radius_m);
-        v.positive("foot_radius_m", self.foot_radius_m);
-        v.non_negative("foot_friction", self.foot_friction);
-        v.positive("leg_rest_length_m", self.leg_rest_length_m);
-        v.positive("leg_min_length_m", self.leg_min_length_m);
-        v.positive("leg_spring_n_per_m", self.leg_spring_n_per_m);
-        v.non_negative("leg_damping_n_s_per_m", self.leg_damping_n_s_per_m);
-        v.require(
-            self.leg_min_length_m < self.leg_rest_length_m,
-            "leg_min_length_m",
-            format!("must be below leg_rest_length_m ({})", self.leg_rest_length_m),
-        );
-        v.require(
-            self.upper_leg_length_m > 2.0 * self.leg_radius_m && self.lower_leg_length_m > self.foot_radius_m,
-            "upper_leg_length_m",
-            "each leg part must be longer than it is thick: upper_leg_length_m above twice leg_radius_m, lower_leg_length_m above foot_radius_m",
-        );
-        v.require(
-            self.lower_leg_length_m + y < self.leg_min_length_m,
-            "lower_leg_length_m",
-            "the lower leg would reach into the body at the shortest leg: keep lower_leg_length_m + body half height below leg_min_length_m",
-        );
+        for (i, leg) in legs.iter().enumerate() {
+            v.require(
+                leg.lower_length_m + y < leg.min_length_m,
+                "body_half_extents_m.1",
+                format!(
+                    "leg {i}'s lower leg would reach into the body at its shortest: keep its lower_length_m + the body's half height below its min_length_m ({})",
+                    leg.min_length_m
+                ),
+            );
+        }
         let c = &self.controller;
         v.nested("controller", |v| {
             v.positive("flight_time_s", c.flight_time_s);
@@ -243,6 +306,7 @@ impl Validate for RigidConfig {
                 ("yaw_max_torque_nm", c.yaw_max_torque_nm),
                 ("turn_min_speed_m_per_s", c.turn_min_speed_m_per_s),
                 ("max_speed_correction_m_per_s", c.max_speed_correction_m_per_s),
+                ("idle_leg_retract_m", c.idle_leg_retract_m),
             ] {
                 v.non_negative(name, value);
             }

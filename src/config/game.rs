@@ -125,8 +125,6 @@ pub struct CreatureLook {
     /// A nose at the front of the body shows which way a creature faces: its radius as a
     /// share of the body's.
     pub nose_radius_fraction: f32,
-    /// Kinds drawn with two legs (the biped); the others have one.
-    pub two_legged_kinds: Vec<String>,
 }
 
 fn colour(v: &mut Validator, field: &str, c: Srgb) {

@@ -13,7 +13,9 @@ mod scenario;
 mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
-pub use creature::{BodyConfig, CreatureDef, FallConfig, RaibertConfig, RigidConfig, SteeringConfig};
+pub use creature::{
+    BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, Stance, SteeringConfig,
+};
 pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{CameraRules, InfluenceRules, LevelRules};
@@ -42,6 +44,16 @@ impl SimConfig {
     /// `assets_root` (`arena` is a path under it; a creature kind `k` is
     /// `creatures/k.ron`). Every problem is reported with the file it is in.
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
+        Self::load_without_table_of(scenario_path, assets_root, None)
+    }
+
+    /// As [`SimConfig::load`], but kind `without` (if any) gets no gait table, whatever its
+    /// file says: `simlod record-gait` records it anew, even over a broken or outdated one.
+    pub fn load_without_table_of(
+        scenario_path: &Path,
+        assets_root: &Path,
+        without: Option<&str>,
+    ) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
         let rules: LevelRules = load_file(&assets_root.join(&scenario.level_rules))?;
@@ -64,7 +76,11 @@ impl SimConfig {
                         ),
                     ));
                 }
-                load_file(&path)
+                let mut def: CreatureDef = load_file(&path)?;
+                if without == Some(kind) {
+                    def.gait_table = None;
+                }
+                Ok(def)
             },
             |file| load_file(&assets_root.join(file)),
         )
@@ -150,6 +166,20 @@ fn gait_of(
             &assets_root.join(file),
             "creature",
             format!("the table was recorded for {:?}, not {:?}", table.creature, kind.name),
+        ));
+    }
+    let steps = kind.stance.steps_per_stride(kind.legs.len());
+    if table.leg_count() != kind.legs.len() || table.steps_per_stride != steps {
+        return Err(ConfigError::one(
+            &assets_root.join(file),
+            "columns",
+            format!(
+                "the table poses {} legs in strides of {} steps; {:?} has {} legs in strides of {steps}: record it again",
+                table.leg_count(),
+                table.steps_per_stride,
+                kind.name,
+                kind.legs.len()
+            ),
         ));
     }
     Ok(Some(table))

@@ -6,8 +6,8 @@ use bevy::prelude::*;
 use rand::RngExt;
 use std::ops::Index;
 
-use crate::config::{CreatureDef, RigidConfig, SimConfig, SteeringConfig};
-use crate::gait::{GaitPose, GaitTable};
+use crate::config::{CreatureDef, LegConfig, RigidConfig, SimConfig, SteeringConfig};
+use crate::gait::{GaitPose, GaitTable, LegPose};
 use crate::lod::{LevelChoice, Lod};
 use crate::outcome::CollisionRecord;
 use crate::{SimEntity, SimStart, WorldRng};
@@ -58,44 +58,67 @@ impl PlanarState {
     }
 }
 
-/// Where the creature is in its hop cycle, kept at every level so that a level switch can
-/// wait for the flight window (paper 3.4): read from the controller at the rigid level,
-/// advanced by time at the others.
+/// Where the creature is in its gait, kept at every level so that a level switch can wait for
+/// the flight window (paper 3.4): read from the controller at the rigid level, advanced by
+/// time at the others. A step runs from one touchdown to the next (a hop of the hopper); a
+/// stride is one step of each leg in turn (one step when the legs share the ground together).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GaitPhase {
-    /// Fraction of the hop cycle since the last touchdown, in `[0, 1)`.
+    /// Fraction of the step since the last touchdown, in `[0, 1)`.
     pub cycle: f32,
     pub in_flight: bool,
     /// Simulated time of the last touchdown, s.
     pub last_touchdown_s: f32,
     /// Touchdown to touchdown, s.
     pub hop_period_s: f32,
+    /// Part of the step on the ground, from touchdown.
+    pub stance_fraction: f32,
+    /// Which step of the stride this is: the leg that touched down last, with legs in turn.
+    pub step: u8,
 }
 
 impl GaitPhase {
-    /// At `cycle` of a hop of `hop_period_s`, at time `now_s`.
+    /// At `cycle` of the first step of a stride, steps of `hop_period_s`, at time `now_s`.
     pub fn at(cycle: f32, hop_period_s: f32, stance_fraction: f32, now_s: f32) -> Self {
         Self {
             cycle,
             in_flight: cycle >= stance_fraction,
             last_touchdown_s: now_s - cycle * hop_period_s,
             hop_period_s,
+            stance_fraction,
+            step: 0,
         }
     }
 
-    /// Advances the cycle by `dt` from `now_s` at the given rhythm: stance first, then flight.
-    pub fn advance(&mut self, hop_period_s: f32, stance_fraction: f32, now_s: f32, dt: f32) {
+    /// Advances the cycle by `dt` from `now_s` at the given rhythm: stance first, then flight;
+    /// a touchdown starts the next of `steps_per_stride` steps.
+    pub fn advance(&mut self, hop_period_s: f32, stance_fraction: f32, steps_per_stride: u32, now_s: f32, dt: f32) {
         let cycle = self.cycle + dt / hop_period_s;
         *self = if cycle >= 1.0 {
-            Self::at(cycle.fract(), hop_period_s, stance_fraction, now_s + dt)
+            Self {
+                step: ((u32::from(self.step) + 1) % steps_per_stride.max(1)) as u8,
+                ..Self::at(cycle.fract(), hop_period_s, stance_fraction, now_s + dt)
+            }
         } else {
             Self {
                 cycle,
                 in_flight: cycle >= stance_fraction,
                 hop_period_s,
+                stance_fraction,
                 ..*self
             }
         };
+    }
+
+    /// How far through the stride (0..1 from the first leg's touchdown): the gait table's phase.
+    pub fn stride(&self, steps_per_stride: u32) -> f32 {
+        (f32::from(self.step) + self.cycle) / steps_per_stride.max(1) as f32
+    }
+
+    /// How far through its flight the creature is (0 lift-off, 1 touchdown), if in flight.
+    pub fn flight_progress(&self) -> Option<f32> {
+        self.in_flight
+            .then(|| ((self.cycle - self.stance_fraction) / (1.0 - self.stance_fraction).max(1e-3)).clamp(0.0, 1.0))
     }
 }
 
@@ -119,8 +142,13 @@ pub struct KindParams {
     /// How fast the rigid model's command follows the desired velocity.
     pub command_acceleration_m_per_s2: f32,
     pub turn_rate_rad_per_s: f32,
-    /// Standing pose: the point-mass level holds it (the leg straight down).
+    /// Standing pose: the point-mass level holds it (the legs straight down).
     pub standing_pose: GaitPose,
+    /// Where each leg's hip sits on the body (x forward, y up, z to the right).
+    pub hips_m: Vec<Vec3>,
+    pub legs: Vec<LegConfig>,
+    /// Steps in a stride: the legs taking turns, or together.
+    pub steps_per_stride: u32,
     /// Hop cycles per second.
     pub cycles_per_s: f32,
     /// Part of the cycle before lift-off.
@@ -146,6 +174,11 @@ impl KindParams {
     }
 
     pub fn new(d: &CreatureDef, gait: Option<&GaitTable>) -> Self {
+        let hips_m: Vec<Vec3> = d.legs.iter().map(|l| Vec3::from(l.hip_m)).collect();
+        let standing: Vec<LegPose> = hips_m
+            .iter()
+            .map(|hip| LegPose::straight(d.body.hip_height_m + hip.y))
+            .collect();
         Self {
             radius_m: d.body.radius_m,
             mass_kg: d.body.mass_kg,
@@ -153,11 +186,10 @@ impl KindParams {
             acceleration_limit_m_per_s2: gait.map_or(d.acceleration_limit_m_per_s2, |g| g.acceleration_limit_m_per_s2),
             command_acceleration_m_per_s2: d.acceleration_limit_m_per_s2,
             turn_rate_rad_per_s: d.turn_rate_deg_per_s.to_radians(),
-            standing_pose: GaitPose {
-                body_height_m: d.body.hip_height_m,
-                leg_length_m: d.body.hip_height_m,
-                ..default()
-            },
+            standing_pose: GaitPose::new(d.body.hip_height_m, 0.0, 0.0, &standing),
+            hips_m,
+            legs: d.legs.clone(),
+            steps_per_stride: d.stance.steps_per_stride(d.legs.len()),
             cycles_per_s: 1.0 / d.hop_period_s,
             stance_fraction: 1.0 - d.flight_fraction,
             fall_impact_speed_m_per_s: d.fall_impact_speed_m_per_s,
@@ -180,6 +212,20 @@ impl KindParams {
 /// The creature kinds of this run, indexed by [`Creature::kind`].
 #[derive(Resource, Clone, Debug)]
 pub struct KindTable(pub Vec<KindParams>);
+
+impl KindTable {
+    /// The kinds of a run's config.
+    pub fn of(config: &SimConfig) -> Self {
+        Self(
+            config
+                .kinds
+                .iter()
+                .zip(&config.gaits)
+                .map(|(d, g)| KindParams::new(d, g.as_ref()))
+                .collect(),
+        )
+    }
+}
 
 impl Index<usize> for KindTable {
     type Output = KindParams;
@@ -242,7 +288,7 @@ pub fn creature_bundle(
     let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
         (Lod::Hybrid, Some(table)) => {
             let (period, stance) = table.rhythm(0.0);
-            (period, stance, table.pose(0.0, cycle))
+            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
         }
         _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
     };
@@ -294,14 +340,7 @@ impl Occupancy {
 
 /// Places the scenario's creatures in free parts of the court, numbered from 0.
 fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
-    let kinds = KindTable(
-        config
-            .kinds
-            .iter()
-            .zip(&config.gaits)
-            .map(|(d, g)| KindParams::new(d, g.as_ref()))
-            .collect(),
-    );
+    let kinds = KindTable::of(&config);
     let mut serials = SerialCounter::default();
     let half = config.arena.half_extents();
     let clear = config.arena.respawn_creature_clearance_m;
@@ -335,9 +374,10 @@ fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResM
             ));
         }
     }
-    commands.spawn_batch(batch);
-    commands.insert_resource(serials);
+    // The kinds first: a creature's level builds its model from them as it is spawned.
     commands.insert_resource(kinds);
+    commands.insert_resource(serials);
+    commands.spawn_batch(batch);
 }
 
 pub(super) fn plugin(app: &mut App) {

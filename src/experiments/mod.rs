@@ -11,7 +11,7 @@ use bevy::prelude::*;
 use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, PlanarState, PlayerControlled};
 use crate::headless::HeadlessSim;
-use crate::lod::LevelPolicy;
+use crate::lod::{LevelPolicy, Lod};
 
 /// A world with one creature of `kind` at the level `policy` gives it, standing at `start`,
 /// steered from outside, the puck parked. The court is grown to `court_m` square so it can
@@ -37,10 +37,23 @@ pub fn lone_creature(
         .query_filtered::<Entity, With<Creature>>()
         .single(world)
         .expect("one creature");
-    let mut e = world.entity_mut(entity);
-    e.insert((PlayerControlled, DesiredVelocity(Vec2::ZERO)));
-    e.get_mut::<PlanarState>()
-        .expect("a creature has a planar state")
-        .position = start;
+    world
+        .entity_mut(entity)
+        .insert((PlayerControlled, DesiredVelocity(Vec2::ZERO)));
+    stand(world, entity, start, None);
     (sim, entity)
+}
+
+/// Moves a creature to `position` (and turns it to `heading`, if given) between ticks, and
+/// enters its level again there, so that its model (a rigid creature's bodies) stands there too.
+pub fn stand(world: &mut World, entity: Entity, position: Vec2, heading: Option<Vec2>) {
+    let mut e = world.entity_mut(entity);
+    let mut state = e.get_mut::<PlanarState>().expect("a creature has a planar state");
+    state.position = position;
+    if let Some(heading) = heading {
+        state.heading = heading;
+    }
+    let level = *e.get::<Lod>().expect("a creature has a level");
+    e.insert(level);
+    world.flush();
 }

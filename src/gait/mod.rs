@@ -9,57 +9,133 @@ use serde::{Deserialize, Serialize};
 
 use crate::config::{RonAssetLoader, Validate, Validator};
 
-/// The pose columns of a sample, in order.
-pub const COLUMNS: [&str; 6] = [
-    "body_height_m",
-    "roll_rad",
-    "pitch_rad",
-    "leg_length_m",
-    "leg_forward_rad",
-    "leg_sideways_rad",
-];
+pub use crate::config::MAX_LEGS;
 
-/// A body and leg pose: what the hybrid level draws and the rigid level starts from.
+/// The body's columns of a sample, in order; each leg's [`LEG_COLUMNS`] follow.
+pub const BODY_COLUMNS: [&str; 3] = ["body_height_m", "roll_rad", "pitch_rad"];
+/// Each leg's columns of a sample, in order, named `legs[i].<column>`.
+pub const LEG_COLUMNS: [&str; 3] = ["length_m", "forward_rad", "sideways_rad"];
+
+/// The columns of a gait table for a kind with `legs` legs.
+pub fn columns(legs: usize) -> Vec<String> {
+    BODY_COLUMNS
+        .iter()
+        .map(|c| (*c).to_owned())
+        .chain((0..legs).flat_map(|i| LEG_COLUMNS.iter().map(move |c| format!("legs[{i}].{c}"))))
+        .collect()
+}
+
+/// One leg's pose, from its hip.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LegPose {
+    /// Hip to foot centre.
+    pub length_m: f32,
+    /// Leg angle from vertical toward the body's front, and toward its left side.
+    pub forward_rad: f32,
+    pub sideways_rad: f32,
+}
+
+impl LegPose {
+    /// Hanging straight down at `length_m`.
+    pub fn straight(length_m: f32) -> Self {
+        Self { length_m, ..default() }
+    }
+
+    /// Unit vector from hip to foot in the body's frame.
+    pub fn direction(&self) -> Vec3 {
+        Vec3::new(self.forward_rad.tan(), -1.0, -self.sideways_rad.tan()).normalize()
+    }
+
+    /// The leg's rotation at the hip from hanging straight down, in the body's frame.
+    pub fn hip_rotation(&self) -> Quat {
+        Quat::from_rotation_arc(Vec3::NEG_Y, self.direction())
+    }
+
+    /// The pose of a leg whose foot is at `to_foot` from its hip, in the body's frame.
+    pub fn toward(to_foot: Vec3) -> Self {
+        Self {
+            length_m: to_foot.length(),
+            forward_rad: to_foot.x.atan2(-to_foot.y),
+            sideways_rad: (-to_foot.z).atan2(-to_foot.y),
+        }
+    }
+
+    fn lerp(self, other: Self, t: f32) -> Self {
+        Self {
+            length_m: self.length_m + (other.length_m - self.length_m) * t,
+            forward_rad: self.forward_rad + (other.forward_rad - self.forward_rad) * t,
+            sideways_rad: self.sideways_rad + (other.sideways_rad - self.sideways_rad) * t,
+        }
+    }
+}
+
+/// The pose every level publishes: the body, then each leg. What the game draws, the
+/// recorder records, the hybrid plays back and the rigid level starts from.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GaitPose {
-    /// Height of the hip (body centre) above the ground.
+    /// Height of the body's centre above the ground.
     pub body_height_m: f32,
     /// Body roll and pitch about its forward and sideways axes.
     pub roll_rad: f32,
     pub pitch_rad: f32,
-    /// Hip to foot centre.
-    pub leg_length_m: f32,
-    /// Leg angle from vertical toward the body's front, and toward its left side.
-    pub leg_forward_rad: f32,
-    pub leg_sideways_rad: f32,
+    /// The legs in the kind's order: the first `leg_count` are its legs (a fixed array, so a
+    /// pose is copied, never allocated).
+    legs: [LegPose; MAX_LEGS],
+    leg_count: u8,
 }
 
 impl GaitPose {
-    fn from_row(row: &[f32]) -> Self {
-        Self {
-            body_height_m: row[0],
-            roll_rad: row[1],
-            pitch_rad: row[2],
-            leg_length_m: row[3],
-            leg_forward_rad: row[4],
-            leg_sideways_rad: row[5],
-        }
+    /// The body at `body_height_m`, level, on `legs` (at most [`MAX_LEGS`]; more are dropped).
+    pub fn new(body_height_m: f32, roll_rad: f32, pitch_rad: f32, legs: &[LegPose]) -> Self {
+        let n = legs.len().min(MAX_LEGS);
+        let mut pose = Self {
+            body_height_m,
+            roll_rad,
+            pitch_rad,
+            legs: [LegPose::default(); MAX_LEGS],
+            leg_count: n as u8,
+        };
+        pose.legs[..n].copy_from_slice(&legs[..n]);
+        pose
     }
 
-    pub fn to_row(self) -> [f32; 6] {
-        [
-            self.body_height_m,
-            self.roll_rad,
-            self.pitch_rad,
-            self.leg_length_m,
-            self.leg_forward_rad,
-            self.leg_sideways_rad,
-        ]
+    pub fn legs(&self) -> &[LegPose] {
+        &self.legs[..usize::from(self.leg_count)]
+    }
+
+    pub fn legs_mut(&mut self) -> &mut [LegPose] {
+        &mut self.legs[..usize::from(self.leg_count)]
+    }
+
+    /// From a table's sample: the [`BODY_COLUMNS`], then each leg's [`LEG_COLUMNS`].
+    fn from_row(row: &[f32]) -> Self {
+        let mut pose = Self::new(row[0], row[1], row[2], &[]);
+        for leg in row[3..].chunks_exact(3).take(MAX_LEGS) {
+            pose.legs[usize::from(pose.leg_count)] = LegPose {
+                length_m: leg[0],
+                forward_rad: leg[1],
+                sideways_rad: leg[2],
+            };
+            pose.leg_count += 1;
+        }
+        pose
+    }
+
+    /// As a table's sample (see [`columns`]).
+    pub fn to_row(&self) -> Vec<f32> {
+        [self.body_height_m, self.roll_rad, self.pitch_rad]
+            .into_iter()
+            .chain(
+                self.legs()
+                    .iter()
+                    .flat_map(|l| [l.length_m, l.forward_rad, l.sideways_rad]),
+            )
+            .collect()
     }
 
     /// The body's rotation when it faces `heading` on the plane: yaw, then pitch, then roll
-    /// (what [`crate::models::rigid::rigid_pose`] reads back). Rapier's body frame: x forward,
-    /// y up, z to the right.
+    /// (what [`GaitPose::of_bodies`] reads back). Rapier's body frame: x forward, y up, z to
+    /// the right.
     pub fn body_rotation(&self, heading: Vec2) -> Quat {
         Quat::from_euler(
             EulerRot::YZX,
@@ -69,33 +145,61 @@ impl GaitPose {
         )
     }
 
-    /// Unit vector from hip to foot in the body's frame.
-    pub fn leg_direction(&self) -> Vec3 {
-        Vec3::new(self.leg_forward_rad.tan(), -1.0, -self.leg_sideways_rad.tan()).normalize()
+    /// The pose of a body at `body` whose legs, with hips at `hips` on the body, reach their
+    /// feet at `feet` (world positions).
+    pub fn of_bodies(body: &Transform, hips: &[Vec3], feet: impl IntoIterator<Item = Vec3>) -> Self {
+        let (_, pitch, roll) = body.rotation.to_euler(EulerRot::YZX);
+        let to_body = body.rotation.inverse();
+        let mut pose = Self::new(body.translation.y, roll, pitch, &[]);
+        for (hip, foot) in hips.iter().zip(feet).take(MAX_LEGS) {
+            pose.legs[usize::from(pose.leg_count)] = LegPose::toward(to_body * (foot - body.translation) - *hip);
+            pose.leg_count += 1;
+        }
+        pose
     }
 
-    /// The leg's rotation at the hip from hanging straight down, in the body's frame.
-    pub fn hip_rotation(&self) -> Quat {
-        Quat::from_rotation_arc(Vec3::NEG_Y, self.leg_direction())
+    /// Each leg's hip and foot in the world, for a body standing at `position` facing
+    /// `heading`, its hips at `hips` on the body.
+    pub fn hips_and_feet<'a>(
+        &'a self,
+        position: Vec2,
+        heading: Vec2,
+        hips: &'a [Vec3],
+    ) -> impl Iterator<Item = (Vec3, Vec3)> + 'a {
+        let rotation = self.body_rotation(heading);
+        let centre = Vec3::new(position.x, self.body_height_m, position.y);
+        self.legs().iter().zip(hips).map(move |(leg, hip)| {
+            let hip = centre + rotation * *hip;
+            (hip, hip + rotation * leg.direction() * leg.length_m)
+        })
     }
 
     fn lerp(self, other: Self, t: f32) -> Self {
-        let (a, b) = (self.to_row(), other.to_row());
-        Self::from_row(&std::array::from_fn::<f32, 6, _>(|i| a[i] + (b[i] - a[i]) * t))
+        let mut pose = Self {
+            body_height_m: self.body_height_m + (other.body_height_m - self.body_height_m) * t,
+            roll_rad: self.roll_rad + (other.roll_rad - self.roll_rad) * t,
+            pitch_rad: self.pitch_rad + (other.pitch_rad - self.pitch_rad) * t,
+            ..self
+        };
+        for (leg, o) in pose.legs.iter_mut().zip(other.legs) {
+            *leg = leg.lerp(o, t);
+        }
+        pose
     }
 }
 
-/// One steady speed's hop.
+/// One steady speed's stride: one hop of a hopper, a step of each leg of a biped.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GaitRow {
     /// The steady forward speed the rigid model ran at (measured).
     pub speed_m_per_s: f32,
-    /// Touchdown to touchdown.
+    /// Touchdown to touchdown: one step.
     pub hop_period_s: f32,
-    /// Part of the hop on the ground, from touchdown.
+    /// Part of each step on the ground, from touchdown.
     pub stance_fraction: f32,
-    /// Poses from touchdown on, at `sample_hz`; each has the [`COLUMNS`].
+    /// Poses from the first leg's touchdown on, over the stride, at `sample_hz`; each has the
+    /// table's `columns`.
     pub samples: Vec<Vec<f32>>,
 }
 
@@ -105,7 +209,9 @@ pub struct GaitRow {
 pub struct GaitTable {
     pub creature: String,
     pub sample_hz: f32,
-    /// The names of a sample's values, in order: must be [`COLUMNS`].
+    /// Steps in a stride: 1 for legs in stance together, the leg count for legs in turn.
+    pub steps_per_stride: u32,
+    /// The names of a sample's values, in order: [`columns`] of the kind's leg count.
     pub columns: Vec<String>,
     /// The rigid model's effective limits, which the point mass of the lower levels matches.
     pub acceleration_limit_m_per_s2: f32,
@@ -119,10 +225,20 @@ impl Validate for GaitTable {
         v.positive("sample_hz", self.sample_hz);
         v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
         v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
+        let legs = self.leg_count();
         v.require(
-            self.columns.iter().map(String::as_str).eq(COLUMNS),
+            (1..=MAX_LEGS).contains(&legs) && self.columns == columns(legs),
             "columns",
-            format!("must be {COLUMNS:?}, got {:?}", self.columns),
+            format!(
+                "must be the body's then each leg's columns ({:?} for one leg), got {:?}",
+                columns(1),
+                self.columns
+            ),
+        );
+        v.require(
+            (1..=MAX_LEGS as u32).contains(&self.steps_per_stride),
+            "steps_per_stride",
+            format!("must be 1 to {MAX_LEGS}, got {}", self.steps_per_stride),
         );
         v.require(
             !self.rows.is_empty(),
@@ -136,20 +252,20 @@ impl Validate for GaitTable {
                 v.within("stance_fraction", row.stance_fraction, 0.0, 1.0);
                 v.require(!row.samples.is_empty(), "samples", "has no samples");
                 for (j, sample) in row.samples.iter().enumerate() {
-                    if sample.len() != COLUMNS.len() {
+                    if sample.len() != self.columns.len() {
                         v.fail(
                             &format!("samples[{j}]"),
                             format!(
                                 "has {} values; every sample has {} ({})",
                                 sample.len(),
-                                COLUMNS.len(),
-                                COLUMNS.join(", ")
+                                self.columns.len(),
+                                self.columns.join(", ")
                             ),
                         );
                     } else if let Some(k) = sample.iter().position(|x| !x.is_finite()) {
                         v.fail(
                             &format!("samples[{j}]"),
-                            format!("{} is {}: must be a finite number", COLUMNS[k], sample[k]),
+                            format!("{} is {}: must be a finite number", self.columns[k], sample[k]),
                         );
                     }
                 }
@@ -181,12 +297,14 @@ fn bracket(rows: &[GaitRow], speed: f32) -> (&GaitRow, &GaitRow, f32) {
 }
 
 impl GaitRow {
-    /// The pose at `cycle` (0..1 from touchdown), between samples and across the wrap.
-    fn pose(&self, cycle: f32, sample_hz: f32) -> GaitPose {
+    /// The pose at `stride` (0..1 from the first leg's touchdown), between samples and
+    /// across the wrap.
+    fn pose(&self, stride: f32, steps: u32, sample_hz: f32) -> GaitPose {
         let n = self.samples.len();
-        // Sample k was taken at k / sample_hz; as a share of the hop that is k / (period * hz).
-        let per_hop = self.hop_period_s * sample_hz;
-        let x = (cycle.rem_euclid(1.0) * per_hop).min(n as f32);
+        // Sample k was taken at k / sample_hz; as a share of the stride that is
+        // k / (stride period * hz).
+        let per_hop = self.hop_period_s * steps as f32 * sample_hz;
+        let x = (stride.rem_euclid(1.0) * per_hop).min(n as f32);
         let k = (x.floor() as usize).min(n - 1);
         let next = (k + 1) % n;
         // The last interval runs from the last sample to the next touchdown (sample 0).
@@ -197,10 +315,18 @@ impl GaitRow {
 }
 
 impl GaitTable {
-    /// The pose at `speed` and hop `cycle` (0..1 from touchdown).
-    pub fn pose(&self, speed: f32, cycle: f32) -> GaitPose {
+    /// The legs its samples pose.
+    pub fn leg_count(&self) -> usize {
+        self.columns.len().saturating_sub(BODY_COLUMNS.len()) / LEG_COLUMNS.len()
+    }
+
+    /// The pose at `speed` and `stride` phase (0..1 from the first leg's touchdown; see
+    /// [`crate::creature::GaitPhase::stride`]).
+    pub fn pose(&self, speed: f32, stride: f32) -> GaitPose {
         let (a, b, t) = bracket(&self.rows, speed);
-        a.pose(cycle, self.sample_hz).lerp(b.pose(cycle, self.sample_hz), t)
+        let steps = self.steps_per_stride;
+        a.pose(stride, steps, self.sample_hz)
+            .lerp(b.pose(stride, steps, self.sample_hz), t)
     }
 
     /// Hop period and stance share at `speed`.

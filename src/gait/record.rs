@@ -2,21 +2,22 @@
 //! motion from the dynamic simulation with forward velocities of 0, 1, 2, and 3 m/s ... at a
 //! rate of 30 samples/second for the period of time from one touchdown to the next").
 //!
-//! At each speed the rigid hopper runs until its gait is steady, then several hops are each
-//! resampled at 30 Hz from touchdown and averaged. A second run from standing to the top
+//! At each speed the rigid model runs until its gait is steady, then several strides (a hop of
+//! the hopper; a step of each leg of a biped) are each resampled at 30 Hz from the first leg's
+//! touchdown and averaged. It reads only what every level publishes (pose, gait phase, planar
+//! state). A second run from standing to the top
 //! speed measures the acceleration the point mass must match. The world is seeded, so the
 //! same files give the same table.
 
 use bevy::prelude::*;
 use std::fmt::Write as _;
 
-use super::{COLUMNS, GaitPose, GaitRow, GaitTable};
+use super::{GaitPose, GaitRow, GaitTable, columns};
 use crate::config::SimConfig;
-use crate::creature::{DesiredVelocity, PlanarState};
+use crate::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use crate::experiments::{EXPERIMENT_COURT_M, lone_creature};
 use crate::headless::HeadlessSim;
 use crate::lod::LevelPolicy;
-use crate::models::rigid::{Raibert, RigidHopper, rigid_pose};
 
 /// How a table is recorded.
 #[derive(Clone, Debug)]
@@ -25,9 +26,9 @@ pub struct RecordSettings {
     pub speeds_m_per_s: Vec<f32>,
     /// Running time before recording starts at each speed.
     pub settle_s: f32,
-    /// Hops averaged per speed.
+    /// Strides averaged per speed.
     pub hops: usize,
-    /// The hops are steady when their periods differ by at most this share of their mean,
+    /// The strides are steady when their periods differ by at most this share of their mean,
     /// and their mean speeds by at most `steady_speed_m_per_s`.
     pub steady_period_share: f32,
     pub steady_speed_m_per_s: f32,
@@ -50,119 +51,126 @@ impl Default for RecordSettings {
     }
 }
 
-/// One tick's record of a running hopper.
+/// One tick's record of a running creature: what every level publishes.
 #[derive(Clone, Copy)]
 struct Tick {
     t: f32,
     pose: GaitPose,
     position: Vec2,
-    liftoff_s: f32,
 }
 
-/// A hopper commanded at `speed` along +x, stepped one tick per update.
+/// A creature commanded at `speed` along +x, stepped one tick per update.
 fn runner(config: &SimConfig, kind: &str, speed: f32) -> (HeadlessSim, Entity) {
     let mut config = config.clone();
     config.scenario.decision_hz = config.scenario.tick_hz;
     // From near one wall toward the other: the longest straight run the court allows.
     let start = Vec2::new(10.0 - EXPERIMENT_COURT_M / 2.0, 0.0);
-    let (mut sim, hopper) = lone_creature(&config, kind, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
+    let (mut sim, creature) = lone_creature(&config, kind, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
     sim.app
         .world_mut()
-        .entity_mut(hopper)
+        .entity_mut(creature)
         .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
-    (sim, hopper)
+    (sim, creature)
 }
 
-fn sample(sim: &mut HeadlessSim, hopper: Entity) -> Result<(Tick, f32), String> {
+/// This tick's pose and position, and the gait phase; an error once the creature has fallen
+/// (and was removed).
+fn sample(sim: &mut HeadlessSim, creature: Entity) -> Result<(Tick, GaitPhase), String> {
     let world = sim.app.world();
-    let fell = || format!("the rigid hopper fell at {:.2} s", sim.clock().seconds());
-    let raibert = world.get::<Raibert>(hopper).ok_or_else(fell)?;
-    let parts = world.get::<RigidHopper>(hopper).ok_or_else(fell)?;
-    let state = world.get::<PlanarState>(hopper).ok_or_else(fell)?;
-    let body = world.get::<Transform>(parts.body).ok_or_else(fell)?;
-    let foot = world.get::<Transform>(parts.lower_leg).ok_or_else(fell)?;
-    let pose = rigid_pose(body, foot);
+    let fell = || format!("the rigid model fell at {:.2} s", sim.clock().seconds());
+    let pose = *world.get::<GaitPose>(creature).ok_or_else(fell)?;
+    let state = world.get::<PlanarState>(creature).ok_or_else(fell)?;
+    let gait = *world.get::<GaitPhase>(creature).ok_or_else(fell)?;
     let tick = Tick {
         t: sim.clock().seconds() as f32,
         pose,
         position: state.position,
-        liftoff_s: raibert.last_liftoff_s,
     };
-    Ok((tick, raibert.last_touchdown_s))
+    Ok((tick, gait))
 }
 
-/// How unsteady a run of hops is: the spread of their periods as a share of the mean, and
+/// How unsteady a run of strides is: the spread of their periods as a share of the mean, and
 /// the spread of their mean speeds.
-fn unsteadiness(hops: &[(f32, f32)], ticks: &[Tick]) -> (f32, f32) {
+fn unsteadiness(strides: &[(f32, f32)], ticks: &[Tick]) -> (f32, f32) {
     let at = |t: f32| ticks.iter().find(|tk| tk.t >= t).map_or(Vec2::ZERO, |tk| tk.position);
-    let periods: Vec<f32> = hops.iter().map(|(a, b)| b - a).collect();
-    let speeds: Vec<f32> = hops.iter().map(|&(a, b)| (at(b) - at(a)).length() / (b - a)).collect();
+    let periods: Vec<f32> = strides.iter().map(|(a, b)| b - a).collect();
+    let speeds: Vec<f32> = strides
+        .iter()
+        .map(|&(a, b)| (at(b) - at(a)).length() / (b - a))
+        .collect();
     let spread = |v: &[f32]| v.iter().copied().fold(f32::MIN, f32::max) - v.iter().copied().fold(f32::MAX, f32::min);
     let mean = periods.iter().sum::<f32>() / periods.len() as f32;
     (spread(&periods) / mean, spread(&speeds))
 }
 
-/// Records `hops` steady hops at `speed` and averages them into a row: after settling, the
-/// last `hops` hops, once they are steady.
-fn record_row(config: &SimConfig, kind: &str, speed: f32, s: &RecordSettings) -> Result<GaitRow, String> {
-    let (mut sim, hopper) = runner(config, kind, speed);
+/// Records `hops` steady strides at `speed` and averages them into a row: after settling,
+/// the last `hops` strides (each from the first leg's touchdown), once they are steady.
+fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &RecordSettings) -> Result<GaitRow, String> {
+    let (mut sim, creature) = runner(config, kind, speed);
     sim.run_for(f64::from(s.settle_s));
     let mut ticks: Vec<Tick> = Vec::new();
-    let mut touchdowns: Vec<f32> = Vec::new();
-    let (_, mut last) = sample(&mut sim, hopper)?;
-    let hops = loop {
+    let mut stride_starts: Vec<f32> = Vec::new();
+    // The stance share of each step, known at the touchdown that ends it.
+    let mut stance_shares: Vec<(f32, f32)> = Vec::new();
+    let (_, mut last) = sample(&mut sim, creature)?;
+    let strides = loop {
         sim.advance_frame();
-        let (tick, touchdown) = sample(&mut sim, hopper)?;
-        let touched_down = touchdown != last;
+        let (tick, gait) = sample(&mut sim, creature)?;
+        let touched_down = gait.last_touchdown_s != last.last_touchdown_s;
+        let stride_starts_now = touched_down && gait.step == 0;
         if touched_down {
-            touchdowns.push(touchdown);
-            last = touchdown;
+            let stance_s = last.stance_fraction * last.hop_period_s;
+            let step_s = gait.last_touchdown_s - last.last_touchdown_s;
+            stance_shares.push((gait.last_touchdown_s, stance_s / step_s.max(1e-3)));
         }
-        if !touchdowns.is_empty() {
+        last = gait;
+        if stride_starts_now {
+            stride_starts.push(gait.last_touchdown_s);
+        }
+        if !stride_starts.is_empty() {
             ticks.push(tick);
         }
-        if touched_down && touchdowns.len() > s.hops {
-            let recent = &touchdowns[touchdowns.len() - s.hops - 1..];
-            let hops: Vec<(f32, f32)> = recent.windows(2).map(|w| (w[0], w[1])).collect();
-            let (period_share, speed_spread) = unsteadiness(&hops, &ticks);
+        if stride_starts_now && stride_starts.len() > s.hops {
+            let recent = &stride_starts[stride_starts.len() - s.hops - 1..];
+            let strides: Vec<(f32, f32)> = recent.windows(2).map(|w| (w[0], w[1])).collect();
+            let (period_share, speed_spread) = unsteadiness(&strides, &ticks);
             if period_share <= s.steady_period_share && speed_spread <= s.steady_speed_m_per_s {
-                break hops;
+                break strides;
             }
         }
         if sim.clock().seconds() > f64::from(s.settle_s + s.steady_within_s) {
             return Err(format!(
-                "no steady hopping at {speed} m/s within {} s: {} touchdowns",
+                "no steady gait at {speed} m/s within {} s: {} strides",
                 s.steady_within_s,
-                touchdowns.len()
+                stride_starts.len()
             ));
         }
     };
-    let period = hops.iter().map(|(a, b)| b - a).sum::<f32>() / hops.len() as f32;
+    let period = strides.iter().map(|(a, b)| b - a).sum::<f32>() / strides.len() as f32;
     let n = (period * s.sample_hz).ceil() as usize;
-    let mut sums = vec![[0.0f32; 6]; n];
-    let mut stance = 0.0;
-    for &(start, end) in &hops {
+    let mut sums = vec![vec![0.0f32; ticks[0].pose.to_row().len()]; n];
+    for &(start, end) in &strides {
         for (k, sum) in sums.iter_mut().enumerate() {
-            // The same share of each hop as sample k is of the mean hop.
+            // The same share of each stride as sample k is of the mean stride.
             let t = start + (k as f32 / s.sample_hz) / period * (end - start);
-            let row = pose_at(&ticks, t).to_row();
-            for (acc, x) in sum.iter_mut().zip(row) {
+            for (acc, x) in sum.iter_mut().zip(pose_at(&ticks, t).to_row()) {
                 *acc += x;
             }
         }
-        let liftoff = ticks
-            .iter()
-            .find(|tk| tk.t > start && tk.liftoff_s > start)
-            .map_or(end, |tk| tk.liftoff_s);
-        stance += (liftoff - start) / (end - start);
     }
-    let count = hops.len() as f32;
+    let (first, last) = (strides[0].0, strides[strides.len() - 1].1);
+    // The steps that end inside the recorded strides.
+    let shares: Vec<f32> = stance_shares
+        .iter()
+        .filter(|(end, _)| *end > first && *end <= last)
+        .map(|(_, share)| *share)
+        .collect();
+    let count = strides.len() as f32;
     let at = |t: f32| ticks.iter().find(|tk| tk.t >= t).map_or(Vec2::ZERO, |tk| tk.position);
-    let (first, last) = (hops[0].0, hops[hops.len() - 1].1);
     Ok(GaitRow {
         speed_m_per_s: (at(last) - at(first)).length() / (last - first),
-        hop_period_s: period,
-        stance_fraction: stance / count,
+        hop_period_s: period / steps as f32,
+        stance_fraction: shares.iter().sum::<f32>() / shares.len().max(1) as f32,
         samples: sums
             .into_iter()
             .map(|sum| sum.iter().map(|x| x / count).collect())
@@ -175,40 +183,32 @@ fn pose_at(ticks: &[Tick], t: f32) -> GaitPose {
     let i = ticks.partition_point(|tk| tk.t < t).clamp(1, ticks.len() - 1);
     let (a, b) = (ticks[i - 1], ticks[i]);
     let w = ((t - a.t) / (b.t - a.t).max(1e-6)).clamp(0.0, 1.0);
-    let (ra, rb) = (a.pose.to_row(), b.pose.to_row());
-    let r: Vec<f32> = ra.iter().zip(rb).map(|(x, y)| x + (y - x) * w).collect();
-    GaitPose {
-        body_height_m: r[0],
-        roll_rad: r[1],
-        pitch_rad: r[2],
-        leg_length_m: r[3],
-        leg_forward_rad: r[4],
-        leg_sideways_rad: r[5],
-    }
+    a.pose.lerp(b.pose, w)
 }
 
 /// From standing, commanded to `top`: the acceleration of the hop-averaged speed while it
 /// rises from 10 % to 70 % of `top` (the saturated part a limit describes).
 fn measure_acceleration(config: &SimConfig, kind: &str, top: f32) -> Result<f32, String> {
-    let (mut sim, hopper) = runner(config, kind, 0.0);
+    let (mut sim, creature) = runner(config, kind, 0.0);
     sim.run_for(3.0);
     let start = sim.clock().seconds() as f32;
     sim.app
         .world_mut()
-        .entity_mut(hopper)
+        .entity_mut(creature)
         .insert(DesiredVelocity(Vec2::new(top, 0.0)));
-    let (_, mut last) = sample(&mut sim, hopper)?;
+    let (_, gait) = sample(&mut sim, creature)?;
+    let mut last = gait.last_touchdown_s;
     let mut previous: Option<(f32, Vec2)> = None;
     let mut rising_from: Option<(f32, f32)> = None;
     while sim.clock().seconds() < f64::from(start) + 20.0 {
         sim.advance_frame();
-        let (tick, touchdown) = sample(&mut sim, hopper)?;
-        if touchdown == last {
+        let (tick, gait) = sample(&mut sim, creature)?;
+        if gait.last_touchdown_s == last {
             continue;
         }
-        last = touchdown;
+        last = gait.last_touchdown_s;
         if let Some((t0, p0)) = previous {
-            // The hop-averaged speed belongs to the middle of the hop.
+            // The step-averaged speed belongs to the middle of the hop.
             let (t, speed) = ((t0 + tick.t) / 2.0, (tick.position.x - p0.x) / (tick.t - t0));
             match rising_from {
                 None if speed >= 0.1 * top => rising_from = Some((t, speed)),
@@ -218,21 +218,26 @@ fn measure_acceleration(config: &SimConfig, kind: &str, top: f32) -> Result<f32,
         }
         previous = Some((tick.t, tick.position));
     }
-    Err(format!("the rigid hopper never reached 70 % of {top} m/s in 20 s"))
+    Err(format!("the rigid model never reached 70 % of {top} m/s in 20 s"))
 }
 
 /// Records the table of `kind` (which must have a rigid model in `config`).
 pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Result<GaitTable, String> {
+    let def = &config.kinds[config
+        .kind_index(kind)
+        .ok_or_else(|| format!("no creature kind {kind:?} in the scenario"))?];
+    let steps = def.stance.steps_per_stride(def.legs.len());
     let rows = settings
         .speeds_m_per_s
         .iter()
-        .map(|&v| record_row(config, kind, v, settings))
+        .map(|&v| record_row(config, kind, steps, v, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let top = rows.iter().map(|r| r.speed_m_per_s).fold(0.0, f32::max);
     Ok(GaitTable {
         creature: kind.to_owned(),
         sample_hz: settings.sample_hz,
-        columns: COLUMNS.iter().map(|c| (*c).to_owned()).collect(),
+        steps_per_stride: steps,
+        columns: columns(def.legs.len()),
         acceleration_limit_m_per_s2: measure_acceleration(config, kind, top)?,
         top_speed_m_per_s: top,
         rows,
@@ -250,7 +255,7 @@ pub fn to_file_text(table: &GaitTable, command: &str) -> String {
         text,
         "// Do not edit by hand: run the command again (same files, same table)."
     );
-    let _ = writeln!(text, "// Columns of each sample: {}.", COLUMNS.join(", "));
+    let _ = writeln!(text, "// Columns of each sample: {}.", table.columns.join(", "));
     text.push_str(&body);
     text.push('\n');
     text

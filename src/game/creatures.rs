@@ -1,12 +1,11 @@
 //! Drawing the creatures from their current model, coloured by level (paper figures 5, 6).
 //!
 //! A simulated creature has no transform; each gets a drawing of its own: a root entity
-//! with a body and its legs as children. Drawing is two steps. First, the draw system of
-//! each level writes the [`CreaturePose`] of the creatures at that level from what that
-//! model knows: the rigid level copies its rapier bodies; the hybrid and point-mass levels
-//! stand the body on the point mass in the [`GaitPose`] their model publishes (from the
-//! gait table, or the standing pose). Then [`apply_poses`] moves the meshes, whatever the
-//! level.
+//! with a body and its legs as children. Drawing is two steps. First, [`pose_creatures`]
+//! writes each creature's [`CreaturePose`] from what every level publishes: its planar state
+//! and its [`GaitPose`] (read back from the rapier bodies at the rigid level, played from the
+//! gait table at the hybrid one, the standing pose at the point mass). Then [`apply_poses`]
+//! moves the meshes.
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::prelude::*;
@@ -19,7 +18,6 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::Lod;
-use crate::models::rigid::{RigidHopper, RigidPart};
 
 /// Rapier's bodies face +x; a pose faces -z.
 const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
@@ -32,7 +30,7 @@ const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
 /// The two steps of drawing, in `Update`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DrawCreatures {
-    /// Each level's draw system writes the poses of its creatures.
+    /// The poses of the creatures, from what every level publishes.
     Pose,
     /// The meshes follow the poses.
     Apply,
@@ -85,18 +83,14 @@ struct PlayerMarker {
 fn spawn_visuals(
     mut commands: Commands,
     config: Res<SimConfig>,
-    settings: Res<GameSettings>,
+    kinds: Res<KindTable>,
     meshes: Res<PartMeshes>,
     palette: Res<Palette>,
     creatures: Query<(Entity, &Creature, &Lod), Added<Creature>>,
 ) {
     for (entity, creature, lod) in &creatures {
         let name = &config.kinds[creature.kind].name;
-        let leg_count = if settings.creature_look.two_legged_kinds.contains(name) {
-            2
-        } else {
-            1
-        };
+        let leg_count = kinds[creature.kind].legs.len();
         let body = commands
             .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
             .id();
@@ -150,11 +144,9 @@ fn despawn_orphans(
     }
 }
 
-/// The levels that move as a point mass and publish a [`GaitPose`]: the hybrid (paper 3.2)
-/// poses the body and leg from the gait table; the point mass (3.3) holds its kind's
-/// standing pose, the leg at a constant angle. The body stands where the point mass is,
-/// facing its heading; a two-legged kind has the leg on each side.
-fn pose_from_gait(
+/// Every level publishes where the body stands and its [`GaitPose`]: the body faces its
+/// heading at its planar position, each leg from its hip on the body to its foot.
+fn pose_creatures(
     kinds: Res<KindTable>,
     settings: Res<GameSettings>,
     creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPose)>,
@@ -164,50 +156,15 @@ fn pose_from_gait(
         let Ok((creature, &level, state, gait)) = creatures.get(visual.creature) else {
             continue;
         };
-        if !level.moves_as_point_mass() {
-            continue;
-        }
-        let body_radius = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
-        // Posed as the rigid level would stand in it (`rigid_pose` read backwards).
+        let kind = &kinds[creature.kind];
         let rotation = gait.body_rotation(state.heading);
         let centre = Vec3::new(state.position.x, gait.body_height_m, state.position.y);
-        let leg = rotation * gait.leg_direction() * gait.leg_length_m;
-        let side = rotation * Vec3::Z * body_radius * 0.5;
-        let hips: &[Vec3] = if visual.legs.len() == 2 {
-            &[centre - side, centre + side]
-        } else {
-            &[centre]
-        };
         pose.body = Transform::from_translation(centre).with_rotation(rotation * RAPIER_TO_POSE);
-        pose.body_radius_m = body_radius;
-        pose.legs = hips.iter().map(|&hip| (hip, hip + leg)).collect();
+        pose.body_radius_m = kind.radius_m * settings.creature_look.body_radius_fraction;
+        pose.legs = gait
+            .hips_and_feet(state.position, state.heading, &kind.hips_m)
+            .collect();
         pose.level = level;
-    }
-}
-
-/// The rigid level (paper 3.1): the body and the leg where rapier has them.
-fn pose_rigid_hoppers(
-    kinds: Res<KindTable>,
-    settings: Res<GameSettings>,
-    creatures: Query<(&Creature, &Lod, &RigidHopper)>,
-    parts: Query<&Transform, With<RigidPart>>,
-    mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
-) {
-    for (visual, mut pose) in &mut visuals {
-        let Ok((creature, &Lod::Rigid, hopper)) = creatures.get(visual.creature) else {
-            continue;
-        };
-        let (Ok(body), Ok(hip), Ok(foot)) = (
-            parts.get(hopper.body),
-            parts.get(hopper.upper_leg),
-            parts.get(hopper.lower_leg),
-        ) else {
-            continue;
-        };
-        pose.body = Transform::from_translation(body.translation).with_rotation(body.rotation * RAPIER_TO_POSE);
-        pose.body_radius_m = kinds[creature.kind].radius_m * settings.creature_look.body_radius_fraction;
-        pose.legs = vec![(hip.translation, foot.translation)];
-        pose.level = Lod::Rigid;
     }
 }
 
@@ -315,7 +272,7 @@ pub(super) fn plugin(app: &mut App) {
             Update,
             (
                 (despawn_orphans, spawn_visuals).chain().before(DrawCreatures::Pose),
-                (pose_from_gait, pose_rigid_hoppers).in_set(DrawCreatures::Pose),
+                pose_creatures.in_set(DrawCreatures::Pose),
                 (apply_poses, mark_player).in_set(DrawCreatures::Apply),
             ),
         );

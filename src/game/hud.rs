@@ -193,7 +193,11 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
         "{:.1} fps   simulation {:.2} ms/frame",
         timing.frames_per_s, timing.sim_ms_per_frame
     );
-    let hits: Vec<String> = counts.collisions.iter().map(|(o, n)| format!("{o} {n}")).collect();
+    let hits: Vec<String> = counts
+        .collisions
+        .iter()
+        .map(|(o, n)| format!("{} {n}", o.name()))
+        .collect();
     let _ = writeln!(s, "collisions: {}   falls {}", hits.join(", "), counts.falls);
     let rules = &config.rules;
     let _ = write!(
@@ -220,7 +224,7 @@ fn show_hud(
         let (shown, wanted) = match which {
             HudText::Stats => (true, stats_text(&round, &timing, &counts.0, &config)),
             HudText::Level(level) => {
-                let n = counts.0.levels.get(level.name()).copied().unwrap_or(0);
+                let n = counts.0.levels[*level];
                 (true, format!("{} {n}", level.name().replace('_', " ")))
             }
             HudText::Help => {

@@ -10,11 +10,15 @@ mod switch;
 pub use select::{CameraFromView, LevelChoice, SimCamera, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 
+use bevy::ecs::lifecycle::HookContext;
+use bevy::ecs::world::DeferredWorld;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The level of detail a creature is simulated at; ordered from the cheapest to the most
-/// detailed.
+/// detailed. Inserting a new `Lod` is the switch: its hooks move the creature's level marker
+/// ([`AtPointMass`], [`AtHybrid`], [`AtRigid`]), and each level's observers on its marker
+/// build and tear down what that level is made of. Nothing else knows what a level holds.
 #[derive(
     Component,
     Clone,
@@ -30,6 +34,7 @@ use serde::{Deserialize, Serialize};
     Deserialize,
     clap::ValueEnum,
 )]
+#[component(on_insert = Lod::mark, on_discard = Lod::unmark)]
 pub enum Lod {
     /// A point mass on the plane with an acceleration limit; the leg held at a constant
     /// angle (section 3.3).
@@ -59,7 +64,49 @@ impl Lod {
             Lod::Rigid => "rigid",
         }
     }
+
+    /// Entering a level: the creature gets that level's marker.
+    fn mark(mut world: DeferredWorld, context: HookContext) {
+        let Some(&lod) = world.get::<Lod>(context.entity) else {
+            return;
+        };
+        let mut commands = world.commands();
+        let mut entity = commands.entity(context.entity);
+        match lod {
+            Lod::PointMass => entity.try_insert(AtPointMass),
+            Lod::Hybrid => entity.try_insert(AtHybrid),
+            Lod::Rigid => entity.try_insert(AtRigid),
+        };
+    }
+
+    /// Leaving a level (or the world): the level's marker goes.
+    fn unmark(mut world: DeferredWorld, context: HookContext) {
+        let Some(&lod) = world.get::<Lod>(context.entity) else {
+            return;
+        };
+        let mut commands = world.commands();
+        let mut entity = commands.entity(context.entity);
+        match lod {
+            Lod::PointMass => entity.try_remove::<AtPointMass>(),
+            Lod::Hybrid => entity.try_remove::<AtHybrid>(),
+            Lod::Rigid => entity.try_remove::<AtRigid>(),
+        };
+    }
 }
+
+/// Marks a creature at the point-mass level (paper 3.3). The level markers make the queries
+/// of different levels provably disjoint, so their systems cannot race.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct AtPointMass;
+
+/// Marks a creature at the hybrid level (paper 3.2).
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct AtHybrid;
+
+/// Marks a creature at the rigid level (paper 3.1): adding it builds the bodies, removing it
+/// (a switch down, or a fall) takes them away.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct AtRigid;
 
 /// How levels are chosen (a scenario's `level_policy`, or `--policy`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]

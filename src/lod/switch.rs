@@ -3,20 +3,17 @@
 //! of the running cycle"). A collision cannot wait: a creature below the rigid level that
 //! collides switches to rigid at once.
 //!
-//! The state every level shares is carried across: position, velocity, heading and hop phase
-//! (they live on the creature entity, not in a model). Going rigid builds the bodies at the
-//! planar position and heading, the body at the height the gait table gives for that speed
-//! and phase, moving at the planar velocity (see [`crate::models::rigid`]). Leaving the rigid
-//! level removes its bodies.
+//! The state every level shares is carried across: position, velocity, heading, gait phase
+//! and pose (they live on the creature entity, not in a model). The switch knows nothing of
+//! what a level is made of: it inserts the new [`Lod`], whose hooks move the level markers,
+//! and each level's observers build or tear down its model (see [`crate::models`]).
 
 use bevy::prelude::*;
 
 use super::Lod;
 use super::select::{LevelChoice, levels_may_change};
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
-use crate::gait::GaitPose;
-use crate::models::rigid::{Raibert, RigidHopper};
-use crate::outcome::CollisionRecord;
+use crate::creature::{Creature, GaitPhase, KindTable};
+use crate::outcome::{CollisionRecord, Counts, SwitchCounts};
 use crate::{SimClock, SimStage, SimStart};
 
 /// A creature changed level.
@@ -35,29 +32,11 @@ pub struct LevelSwitched {
 /// Switches and creatures per level over the run.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct SwitchTally {
-    /// Switches by [from][to] level.
-    pub switches: [[u64; 3]; 3],
+    pub switches: SwitchCounts,
     /// Sums and peaks of the creatures at each level, sampled at each decision.
-    pub level_sums: [u64; 3],
-    pub level_peaks: [u64; 3],
+    pub level_sums: Counts<Lod, u64>,
+    pub level_peaks: Counts<Lod, u64>,
     pub samples: u64,
-}
-
-impl SwitchTally {
-    pub fn total(&self) -> u64 {
-        self.switches.iter().flatten().sum()
-    }
-}
-
-/// How far through its flight the creature is, if it is in flight.
-fn flight_progress(lod: Lod, gait: &GaitPhase, raibert: Option<&Raibert>, stance: f32, now: f32) -> Option<f32> {
-    if !gait.in_flight {
-        return None;
-    }
-    Some(match (lod, raibert) {
-        (Lod::Rigid, Some(r)) => ((now - r.last_liftoff_s) / (r.hop_period_s - r.stance_s).max(1e-3)).clamp(0.0, 1.0),
-        _ => ((gait.cycle - stance) / (1.0 - stance).max(1e-3)).clamp(0.0, 1.0),
-    })
 }
 
 fn switch_levels(
@@ -67,52 +46,32 @@ fn switch_levels(
     kinds: Res<KindTable>,
     mut tally: ResMut<SwitchTally>,
     mut switched: MessageWriter<LevelSwitched>,
-    mut creatures: Query<(
-        Entity,
-        &Creature,
-        &mut Lod,
-        &mut LevelChoice,
-        &GaitPhase,
-        &PlanarState,
-        &CollisionRecord,
-        &mut GaitPose,
-        Option<&Raibert>,
-    )>,
+    mut creatures: Query<(Entity, &Creature, &Lod, &mut LevelChoice, &GaitPhase, &CollisionRecord)>,
 ) {
     let now = clock.seconds() as f32;
     let (open, close) = config.rules.flight_window;
-    for (entity, creature, mut lod, mut choice, gait, state, record, mut pose, raibert) in &mut creatures {
+    for (entity, creature, &lod, mut choice, gait, record) in &mut creatures {
         let kind = &kinds[creature.kind];
         let forced =
-            *lod != Lod::Rigid && record.touching.iter().any(|&t| t) && kind.best_level(Lod::Rigid) == Lod::Rigid;
+            lod != Lod::Rigid && record.touching.iter().any(|&t| t) && kind.best_level(Lod::Rigid) == Lod::Rigid;
         let target = if forced { Lod::Rigid } else { choice.wanted };
-        if target == *lod {
+        if target == lod {
             continue;
         }
-        let stance = match &kind.gait {
-            Some(table) if *lod == Lod::Hybrid => table.rhythm(state.velocity.length()).1,
-            _ => kind.stance_fraction,
-        };
-        let progress = flight_progress(*lod, gait, raibert, stance, now);
+        let progress = gait.flight_progress();
         if !forced && !progress.is_some_and(|p| (open..=close).contains(&p)) {
             continue;
         }
-        if *lod == Lod::Rigid {
-            commands.entity(entity).remove::<(RigidHopper, Raibert)>();
-        }
-        if target == Lod::PointMass {
-            *pose = kind.standing_pose;
-        }
-        tally.switches[*lod as usize][target as usize] += 1;
+        commands.entity(entity).insert(target);
+        tally.switches.count(lod, target);
         switched.write(LevelSwitched {
             creature: entity,
             serial: creature.serial,
-            from: *lod,
+            from: lod,
             to: target,
             flight_progress: if forced { None } else { progress },
             at_s: now,
         });
-        *lod = target;
         *choice = LevelChoice {
             wanted: target,
             last_switch_s: now,
@@ -125,14 +84,14 @@ fn count_levels(clock: Res<SimClock>, mut tally: ResMut<SwitchTally>, levels: Qu
     if !clock.is_decision_tick() {
         return;
     }
-    let mut counts = [0u64; 3];
-    for lod in &levels {
-        counts[*lod as usize] += 1;
+    let mut counts: Counts<Lod, u64> = Counts::default();
+    for &lod in &levels {
+        counts[lod] += 1;
     }
     tally.samples += 1;
-    for (i, n) in counts.into_iter().enumerate() {
-        tally.level_sums[i] += n;
-        tally.level_peaks[i] = tally.level_peaks[i].max(n);
+    for (lod, n) in counts.iter() {
+        tally.level_sums[lod] += n;
+        tally.level_peaks[lod] = tally.level_peaks[lod].max(n);
     }
 }
 

@@ -7,9 +7,9 @@
 use crate::creature::GaitPhase;
 use crate::gait::{GaitPose, GaitTable};
 
-/// Advances the hop cycle at the table's rhythm for `speed` and poses the body from it.
+/// Advances the gait at the table's rhythm for `speed` and poses the body and legs from it.
 pub fn play_gait(gait: &mut GaitPhase, pose: &mut GaitPose, table: &GaitTable, speed: f32, now_s: f32, dt: f32) {
     let (period, stance) = table.rhythm(speed);
-    gait.advance(period, stance, now_s, dt);
-    *pose = table.pose(speed, gait.cycle);
+    gait.advance(period, stance, table.steps_per_stride, now_s, dt);
+    *pose = table.pose(speed, gait.stride(table.steps_per_stride));
 }

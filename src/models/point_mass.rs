@@ -9,7 +9,7 @@ use super::hybrid;
 use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::GaitPose;
-use crate::lod::Lod;
+use crate::lod::{AtPointMass, AtRigid, Lod};
 use crate::{SimClock, SimStage};
 
 /// Below this speed the heading is left where it was (no spinning in place).
@@ -38,7 +38,25 @@ pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt
 
 /// Advances the hop cycle by time at the kind's own rhythm.
 pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, now_s: f32, dt: f32) {
-    gait.advance(1.0 / kind.cycles_per_s, kind.stance_fraction, now_s, dt);
+    gait.advance(
+        1.0 / kind.cycles_per_s,
+        kind.stance_fraction,
+        kind.steps_per_stride,
+        now_s,
+        dt,
+    );
+}
+
+/// Entering the point-mass level: the legs go to the kind's standing pose (paper 3.3: "holds
+/// the leg at a constant angle").
+fn enter_point_mass(
+    add: On<Add, AtPointMass>,
+    kinds: Res<KindTable>,
+    mut creatures: Query<(&Creature, &mut GaitPose)>,
+) {
+    if let Ok((creature, mut pose)) = creatures.get_mut(add.entity) {
+        *pose = kinds[creature.kind].standing_pose;
+    }
 }
 
 /// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
@@ -46,14 +64,17 @@ fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
-    mut creatures: Query<(
-        &Creature,
-        &Lod,
-        &DesiredVelocity,
-        &mut PlanarState,
-        &mut GaitPhase,
-        &mut GaitPose,
-    )>,
+    mut creatures: Query<
+        (
+            &Creature,
+            &Lod,
+            &DesiredVelocity,
+            &mut PlanarState,
+            &mut GaitPhase,
+            &mut GaitPose,
+        ),
+        Without<AtRigid>,
+    >,
 ) {
     let (dt, now) = (clock.dt, clock.seconds() as f32);
     for_each_creature!(config.scenario.creature_count(), creatures, |(
@@ -81,13 +102,15 @@ fn step_point_masses(
                 step_planar(&mut state, desired.0, kind, dt);
                 hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), now, dt);
             }
+            // A hybrid whose kind has no table is not made: `KindParams::best_level`.
             _ => {}
         }
     });
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(FixedUpdate, step_point_masses.in_set(SimStage::Step));
+    app.add_observer(enter_point_mass)
+        .add_systems(FixedUpdate, step_point_masses.in_set(SimStage::Step));
 }
 
 #[cfg(test)]
@@ -108,6 +131,9 @@ mod tests {
             command_acceleration_m_per_s2: 2.0,
             turn_rate_rad_per_s: 1000.0,
             standing_pose: GaitPose::default(),
+            hips_m: vec![Vec3::ZERO],
+            legs: Vec::new(),
+            steps_per_stride: 1,
             steering: SteeringConfig {
                 cruise_speed_m_per_s: 1.0,
                 wander_turn_rad_per_s: 0.0,

@@ -10,15 +10,18 @@
 //! Puck and wall contacts are checked every tick; contacts between creatures at each
 //! steering decision, through the spatial index.
 
+mod counts;
+
+pub use counts::{Counts, Key, SwitchCounts};
+
 use bevy::prelude::*;
 use serde::Serialize;
-use std::collections::BTreeMap;
 use std::sync::Mutex;
 
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
 use crate::creature::{Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot};
-use crate::lod::{Lod, SwitchTally};
+use crate::lod::{AtRigid, Lod, SwitchTally};
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart, WorldRng};
 
@@ -81,8 +84,8 @@ impl FallQueue {
 /// Counts kept for the whole run, beyond those of the creatures alive now.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct Tally {
-    /// Collisions, by [`Obstacle`], of creatures already removed.
-    pub removed_collisions: [u64; 3],
+    /// Collisions of creatures already removed.
+    pub removed_collisions: Counts<Obstacle, u64>,
     /// Removed creatures that had collided with the puck or a wall.
     pub removed_collided: u64,
     pub falls: u64,
@@ -173,25 +176,20 @@ fn detect_collisions(
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
-    mut creatures: Query<(Entity, &Creature, &Lod, &mut PlanarState, &mut CollisionRecord)>,
+    mut creatures: Query<(Entity, &Creature, &mut PlanarState, &mut CollisionRecord), Without<AtRigid>>,
 ) {
     let grid = clock.is_decision_tick().then_some(&*grid);
     for_each_creature!(config.scenario.creature_count(), creatures, |(
         entity,
         creature,
-        lod,
         mut state,
         mut record,
     ): (
         Entity,
         &Creature,
-        &Lod,
         Mut<PlanarState>,
         Mut<CollisionRecord>
     )| {
-        if !lod.moves_as_point_mass() {
-            return;
-        }
         let kind = &kinds[creature.kind];
         let impact = collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
         if impact > kind.fall_impact_speed_m_per_s {
@@ -229,7 +227,7 @@ fn respawn_fallen(
             continue;
         };
         for o in Obstacle::ALL {
-            tally.removed_collisions[o as usize] += u64::from(record.count[o as usize]);
+            tally.removed_collisions[o] += u64::from(record.count[o as usize]);
         }
         tally.removed_collided += u64::from(record.hit_puck_or_wall());
         tally.falls += 1;
@@ -263,18 +261,18 @@ pub struct Summary {
     pub creatures: u64,
     /// Collisions by obstacle (`puck`, `wall`, `creature`); a contact between two creatures
     /// counts once for each.
-    pub collisions: BTreeMap<&'static str, u64>,
+    pub collisions: Counts<Obstacle, u64>,
     /// Creatures that collided with the puck or a wall (the paper's figure 10 measure).
     pub creatures_collided: u64,
     pub falls: u64,
     pub respawns: u64,
     /// Creatures at each level at the end.
-    pub levels: BTreeMap<&'static str, u64>,
+    pub levels: Counts<Lod, u64>,
     /// Level switches: `total`, and by direction (`"hybrid->rigid"`, ...).
-    pub switches: BTreeMap<String, u64>,
+    pub switches: SwitchCounts,
     /// Creatures at each level, averaged over the run's steering decisions, and the peak.
-    pub levels_mean: BTreeMap<&'static str, f64>,
-    pub levels_peak: BTreeMap<&'static str, u64>,
+    pub levels_mean: Counts<Lod, f64>,
+    pub levels_peak: Counts<Lod, u64>,
     pub sim_seconds: f64,
     /// Wall-clock seconds; the only field that differs between identical runs.
     pub wall_seconds: f64,
@@ -288,45 +286,27 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     let seed = world.resource::<SimConfig>().scenario.seed;
     let mut collisions = tally.removed_collisions;
     let mut collided = tally.removed_collided;
-    let mut levels: BTreeMap<&'static str, u64> = Lod::ALL.iter().map(|l| (l.name(), 0)).collect();
+    let mut levels: Counts<Lod, u64> = Counts::default();
     let mut creatures = 0;
     let mut query = world.query::<(&Lod, &CollisionRecord)>();
-    for (lod, record) in query.iter(world) {
+    for (&lod, record) in query.iter(world) {
         creatures += 1;
-        *levels.entry(lod.name()).or_default() += 1;
+        levels[lod] += 1;
         for o in Obstacle::ALL {
-            collisions[o as usize] += u64::from(record.count[o as usize]);
+            collisions[o] += u64::from(record.count[o as usize]);
         }
         collided += u64::from(record.hit_puck_or_wall());
     }
     let sim_seconds = clock.seconds();
     let switching = world.resource::<SwitchTally>().clone();
-    let mut switches: BTreeMap<String, u64> = BTreeMap::from([("total".to_owned(), switching.total())]);
-    for from in Lod::ALL {
-        for to in Lod::ALL {
-            let n = switching.switches[from as usize][to as usize];
-            if n > 0 {
-                switches.insert(format!("{}->{}", from.name(), to.name()), n);
-            }
-        }
-    }
     let samples = switching.samples.max(1) as f64;
     Summary {
-        switches,
-        levels_mean: Lod::ALL
-            .iter()
-            .map(|&l| (l.name(), switching.level_sums[l as usize] as f64 / samples))
-            .collect(),
-        levels_peak: Lod::ALL
-            .iter()
-            .map(|&l| (l.name(), switching.level_peaks[l as usize]))
-            .collect(),
+        switches: switching.switches,
+        levels_mean: Counts::from_fn(|l| switching.level_sums[l] as f64 / samples),
+        levels_peak: switching.level_peaks,
         seed,
         creatures,
-        collisions: Obstacle::ALL
-            .iter()
-            .map(|&o| (o.name(), collisions[o as usize]))
-            .collect(),
+        collisions,
         creatures_collided: collided,
         falls: tally.falls,
         respawns: tally.respawns,

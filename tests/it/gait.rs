@@ -7,9 +7,8 @@ use simlod::config::{ConfigError, SimConfig, load_file};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use simlod::experiments::lone_creature;
 use simlod::gait::record::{RecordSettings, record, to_file_text};
-use simlod::gait::{COLUMNS, GaitPose, GaitTable};
-use simlod::lod::LevelPolicy;
-use simlod::models::rigid::Raibert;
+use simlod::gait::{GaitPose, GaitTable, columns};
+use simlod::lod::{LevelPolicy, Lod};
 
 const SHIPPED: &str = "gaits/hopper.ron";
 const COMMAND: &str = "simlod record-gait --creature assets/creatures/hopper.ron --speeds 0,1,2,3";
@@ -136,10 +135,9 @@ fn pose_gap(speed: f32) -> [f32; 6] {
         // The rigid hopper's phase, measured; the table's pose at that phase and speed.
         let (sim, e) = &runners[0];
         let world = sim.app.world();
-        let raibert = world.get::<Raibert>(*e).expect("the rigid hopper is standing");
-        let now = sim.clock().seconds() as f32;
+        assert_eq!(world.get::<Lod>(*e), Some(&Lod::Rigid), "the rigid hopper is standing");
         let rigid = *world.get::<GaitPose>(*e).unwrap();
-        let phase = raibert.gait_phase(now).cycle;
+        let phase = world.get::<GaitPhase>(*e).unwrap().stride(table.steps_per_stride);
         let speed_now = world.get::<PlanarState>(*e).unwrap().velocity.length();
         let played = table.pose(speed_now, phase);
         for ((g, r), p) in gap.iter_mut().zip(rigid.to_row()).zip(played.to_row()) {
@@ -150,7 +148,7 @@ fn pose_gap(speed: f32) -> [f32; 6] {
         let world = sim.app.world();
         let (g, p) = (world.get::<GaitPhase>(*e).unwrap(), world.get::<GaitPose>(*e).unwrap());
         let s = world.get::<PlanarState>(*e).unwrap();
-        assert_eq!(*p, table.pose(s.velocity.length(), g.cycle));
+        assert_eq!(*p, table.pose(s.velocity.length(), g.stride(table.steps_per_stride)));
     }
     gap
 }
@@ -165,7 +163,7 @@ fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
     let limits = [0.05, 5.0, 5.0, 0.05, 8.0, 8.0];
     for speed in [0.0, 1.5, 2.0, 2.8] {
         let gap = pose_gap(speed);
-        for (i, (column, limit)) in COLUMNS.iter().zip(limits).enumerate() {
+        for (i, (column, limit)) in columns(1).iter().zip(limits).enumerate() {
             let g = if column.ends_with("_rad") {
                 gap[i].to_degrees()
             } else {
@@ -182,6 +180,6 @@ fn the_default_scenario_runs_all_hybrid() {
     let mut config = default_config();
     config.scenario.level_policy = LevelPolicy::AllHybrid;
     let summary = simlod::headless::run(config, 10.0);
-    assert_eq!(summary.levels["hybrid"], 30, "hoppers have a gait table");
-    assert_eq!(summary.levels["point_mass"], 10, "bipeds have none yet");
+    assert_eq!(summary.levels[Lod::Hybrid], 30, "hoppers have a gait table");
+    assert_eq!(summary.levels[Lod::PointMass], 10, "bipeds have none yet");
 }

@@ -9,10 +9,12 @@ mod experiments;
 mod gait;
 #[cfg(feature = "game")]
 mod game;
+mod kinds;
 mod outcome;
 mod player;
 mod restart;
 mod rigid;
+mod schedule;
 mod steering;
 mod support;
 mod switching;

@@ -4,6 +4,7 @@ use crate::support::*;
 use simlod::arena::PuckState;
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
+use simlod::outcome::Obstacle;
 
 #[test]
 fn respawning_keeps_the_creature_count_constant() {
@@ -64,7 +65,7 @@ fn a_creature_in_the_pucks_path_is_hit_and_counted() {
     for _ in 0..30 {
         sim.advance_frame();
         let s = sim.summary(0.0);
-        if s.collisions["puck"] > 0 {
+        if s.collisions[Obstacle::Puck] > 0 {
             hit = true;
             // At 5 m/s the puck's impact beats the hopper's fall threshold of 2 m/s.
             assert_eq!(s.falls, 1);

@@ -23,11 +23,7 @@ fn starting_over_gives_the_same_world_as_a_fresh_start() {
         start_over(restarted.app.world_mut(), config);
         assert_eq!(restarted.clock().tick, 0);
         assert_eq!(restarted.summary(0.0).falls, 0, "the counts start from zero");
-        assert_eq!(
-            restarted.summary(0.0).switches.get("total"),
-            Some(&0),
-            "the switch counts too"
-        );
+        assert_eq!(restarted.summary(0.0).switches.total(), 0, "the switch counts too");
         for _ in 0..90 {
             fresh.advance_frame();
             restarted.advance_frame();

@@ -5,11 +5,11 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::support::*;
-use simlod::creature::{DesiredVelocity, PlanarState};
-use simlod::experiments::lone_creature;
+use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
+use simlod::experiments::{lone_creature, stand};
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
-use simlod::models::rigid::{Raibert, RigidHopper, RigidPart, Shove};
+use simlod::models::rigid::{RigidBodies, RigidPart, Shove};
 
 /// One rigid hopper steered from outside at `desired`, far from the walls and the parked puck.
 pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
@@ -20,9 +20,10 @@ pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
         Vec2::new(-180.0, 100.0),
         420.0,
     );
-    let mut e = sim.app.world_mut().entity_mut(hopper);
-    e.insert(DesiredVelocity(desired));
-    e.get_mut::<PlanarState>().unwrap().heading = desired.try_normalize().unwrap_or(Vec2::X);
+    let world = sim.app.world_mut();
+    world.entity_mut(hopper).insert(DesiredVelocity(desired));
+    let at = world.get::<PlanarState>(hopper).unwrap().position;
+    stand(world, hopper, at, Some(desired.try_normalize().unwrap_or(Vec2::X)));
     (sim, hopper)
 }
 
@@ -33,8 +34,8 @@ fn state(sim: &mut HeadlessSim, entity: Entity) -> Option<PlanarState> {
 fn touchdown(sim: &mut HeadlessSim, entity: Entity) -> f32 {
     sim.app
         .world()
-        .get::<Raibert>(entity)
-        .map_or(f32::NAN, |r| r.last_touchdown_s)
+        .get::<GaitPhase>(entity)
+        .map_or(f32::NAN, |g| g.last_touchdown_s)
 }
 
 /// Runs until `seconds`, returning the positions and times at each touchdown after `from`.
@@ -56,8 +57,9 @@ fn touchdowns(sim: &mut HeadlessSim, entity: Entity, from: f64, seconds: f64) ->
 /// The hopper's whole mass, from its file.
 fn hopper_mass_kg() -> f32 {
     let kind = &config_with_hoppers(1).kinds[0];
-    let rigid = kind.rigid.as_ref().unwrap();
-    kind.body.mass_kg + rigid.upper_leg_mass_kg + rigid.lower_leg_mass_kg
+    kind.legs
+        .iter()
+        .fold(kind.body.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg)
 }
 
 fn falls(sim: &mut HeadlessSim) -> u64 {
@@ -170,7 +172,7 @@ fn a_large_push_makes_it_fall_and_it_is_respawned_without_leaking_bodies() {
 fn a_numerical_blow_up_is_handled_as_a_fall() {
     let (mut sim, hopper) = lone_hopper(Vec2::ZERO);
     sim.run_for(2.0);
-    let leg = sim.app.world().get::<RigidHopper>(hopper).unwrap().lower_leg;
+    let leg = sim.app.world().get::<RigidBodies>(hopper).unwrap().legs[0].lower;
     sim.app.world_mut().get_mut::<Velocity>(leg).unwrap().linear = Vec3::NAN;
     sim.run_for(1.0);
     assert_eq!(falls(&mut sim), 1);
@@ -184,7 +186,7 @@ fn the_default_scenario_runs_all_rigid_with_steering() {
     config.scenario.level_policy = LevelPolicy::AllRigid;
     let summary = simlod::headless::run(config, 10.0);
     // Hoppers have a rigid model; bipeds do not yet and stay point masses.
-    assert_eq!(summary.levels["rigid"], 30);
-    assert_eq!(summary.levels["point_mass"], 10);
+    assert_eq!(summary.levels[Lod::Rigid], 30);
+    assert_eq!(summary.levels[Lod::PointMass], 10);
     assert_eq!(summary.creatures, 40);
 }

@@ -3,6 +3,7 @@
 use crate::support::*;
 use simlod::config::SimConfig;
 use simlod::headless;
+use simlod::outcome::Obstacle;
 
 const SEEDS: std::ops::Range<u64> = 1..11;
 
@@ -13,8 +14,8 @@ fn hits(config: &SimConfig, seconds: f64) -> (u64, u64, u64) {
         let mut c = config.clone();
         c.scenario.seed = seed;
         let s = headless::run(c, seconds);
-        totals.0 += s.collisions["puck"];
-        totals.1 += s.collisions["wall"];
+        totals.0 += s.collisions[Obstacle::Puck];
+        totals.1 += s.collisions[Obstacle::Wall];
         totals.2 += s.creatures_collided;
     }
     totals

@@ -1,27 +1,33 @@
-//! Raibert's hopping controller (Legged Robots That Balance, 1986; paper section 3.1), in
-//! three decoupled parts:
-//! - hop height: the leg spring's rest length is raised by a thrust during the second half of
-//!   stance; the thrust is adjusted once a hop toward the configured flight time;
-//! - body attitude: in stance, a hip torque between body and leg holds the body level, and a
-//!   yaw torque turns it toward its heading (through the foot's grip: rapier's point contact
-//!   has no torsional friction, so that torque acts on the body alone, capped by the grip);
-//! - speed: in flight the hip swings the leg so that the foot lands at the neutral point, half
-//!   the distance the body travels in stance, plus a correction proportional to the velocity
-//!   error.
+//! Raibert's running controller (Legged Robots That Balance, 1986; paper section 3.1), for any
+//! number of legs, in three decoupled parts that act through the leg in stance (Raibert's
+//! "one-foot" running: a biped's legs take turns, each stance like a hop of the hopper):
+//! - hop height: the stance leg's spring rest length is raised by a thrust during the second
+//!   half of stance; the thrust is adjusted once a step toward the configured flight time;
+//! - body attitude: in stance, a hip torque between body and stance leg holds the body level,
+//!   and a yaw torque turns it toward its heading (through the foot's grip: rapier's point
+//!   contact has no torsional friction, so that torque acts on the body alone, capped by the
+//!   grip);
+//! - speed: in flight the hip swings the leg that lands next so that its foot lands at the
+//!   neutral point, half the distance the body travels in stance, plus a correction
+//!   proportional to the velocity error.
+//!
+//! With legs in turn, the idle legs are shortened to clear the ground and swung to mirror the
+//! active leg, so that the next one is forward when its turn comes.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use std::f32::consts::PI;
 
-use super::RigidHopper;
+use super::{RigidBodies, RigidPart};
 use crate::SimClock;
-use crate::config::RigidConfig;
-use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindTable, PlanarState};
+use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
+use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
+use crate::lod::AtRigid;
 use crate::outcome::FallQueue;
 
 /// Foot centre this far above its resting height still counts as on the ground.
 pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
-/// Share of the leg's twist about its own axis (relative to the body) removed each tick. The
+/// Share of a leg's twist about its own axis (relative to the body) removed each tick. The
 /// leg is thin, so its twist inertia is tiny: the damping is scaled to it, or it would
 /// overshoot and blow up.
 const TWIST_DAMPING_PER_TICK: f32 = 0.5;
@@ -32,7 +38,7 @@ const TWIST_DAMPING_PER_TICK: f32 = 0.5;
 #[derive(Component, Clone, Copy, Debug)]
 pub struct Shove(pub Vec3);
 
-/// Where the hopper is in its hop.
+/// Where the creature is in its step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StancePhase {
     Flight,
@@ -42,10 +48,23 @@ pub enum StancePhase {
     Thrust,
 }
 
-/// The controller's state for one hopper.
+/// What a leg does this tick.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Role {
+    /// On the ground: thrust and attitude.
+    Stance,
+    /// In flight, about to land: foot placement.
+    Landing,
+    /// Legs in turn, not this leg's turn: shortened, mirroring the active leg.
+    Idle,
+}
+
+/// The controller's state for one creature.
 #[derive(Component, Clone, Debug)]
 pub struct Raibert {
     pub phase: StancePhase,
+    /// The leg that touched down last: in stance now, or the last one that was.
+    pub stance_leg: usize,
     /// Current thrust (extra spring extension).
     pub thrust_m: f32,
     /// Estimated stance duration, for the neutral point.
@@ -54,8 +73,8 @@ pub struct Raibert {
     pub last_liftoff_s: f32,
     /// Touchdown to touchdown, last measured.
     pub hop_period_s: f32,
-    /// Integral correction of the commanded velocity, updated once a hop, in the frame of the
-    /// command (x along it, y to its left): a neutral-point bias turns with the course.
+    /// Integral correction of the commanded velocity, updated once a step, in the frame of
+    /// the command (x along it, y to its left): a neutral-point bias turns with the course.
     pub speed_correction: Vec2,
     /// The velocity the controller aims at: the desired one, approached no faster than the
     /// creature's acceleration limit, so a sudden change of mind does not trip it.
@@ -63,30 +82,72 @@ pub struct Raibert {
 }
 
 impl Raibert {
-    pub fn new(r: &RigidConfig, mass_kg: f32, velocity: Vec2, now: f32) -> Self {
-        let total = mass_kg + r.upper_leg_mass_kg + r.lower_leg_mass_kg;
-        let stance_s = PI * (total / r.leg_spring_n_per_m).sqrt();
+    /// A controller taking over a creature moving at `velocity` at `gait`'s point of its step.
+    pub fn resuming(kind: &KindParams, r: &RigidConfig, velocity: Vec2, gait: &GaitPhase, now: f32) -> Self {
+        let total = kind
+            .legs
+            .iter()
+            .fold(kind.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg);
+        let stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
+        let hop_period_s = stance_s + r.controller.flight_time_s;
+        let last_touchdown_s = now - gait.cycle * hop_period_s;
         Self {
             phase: StancePhase::Flight,
+            stance_leg: usize::from(gait.step) % kind.legs.len(),
             thrust_m: r.controller.thrust_initial_m,
             stance_s,
-            last_touchdown_s: now,
-            last_liftoff_s: now,
-            hop_period_s: stance_s + r.controller.flight_time_s,
+            last_touchdown_s,
+            last_liftoff_s: (last_touchdown_s + stance_s).min(now),
+            hop_period_s,
             speed_correction: Vec2::ZERO,
             command: velocity,
         }
     }
 
     /// The shared gait phase, as the bodies last touched down and lifted off.
-    pub fn gait_phase(&self, now: f32) -> GaitPhase {
+    pub fn gait_phase(&self, now: f32, steps_per_stride: u32) -> GaitPhase {
+        let stance = match self.phase {
+            StancePhase::Flight => self.last_liftoff_s - self.last_touchdown_s,
+            _ => self.stance_s,
+        };
         GaitPhase {
             cycle: ((now - self.last_touchdown_s) / self.hop_period_s).clamp(0.0, 0.999),
             in_flight: self.phase == StancePhase::Flight,
             last_touchdown_s: self.last_touchdown_s,
             hop_period_s: self.hop_period_s,
+            stance_fraction: (stance / self.hop_period_s).clamp(0.0, 0.999),
+            step: if steps_per_stride > 1 { self.stance_leg as u8 } else { 0 },
         }
     }
+
+    /// The leg that lands next: with legs in turn, the one after the last stance leg.
+    fn landing_leg(&self, legs: usize, together: bool) -> usize {
+        if together {
+            self.stance_leg
+        } else {
+            (self.stance_leg + 1) % legs
+        }
+    }
+
+    fn role(&self, leg: usize, legs: usize, together: bool) -> Role {
+        match self.phase {
+            StancePhase::Flight if together || leg == self.landing_leg(legs, together) => Role::Landing,
+            StancePhase::Compression | StancePhase::Thrust if together || leg == self.stance_leg => Role::Stance,
+            _ => Role::Idle,
+        }
+    }
+}
+
+/// What the controller senses of one leg this tick.
+#[derive(Clone, Copy, Debug, Default)]
+struct LegSensed {
+    /// The upper leg's spin.
+    spin: Vec3,
+    /// Unit vector from hip to foot.
+    axis: Vec3,
+    length: f32,
+    rate: f32,
+    foot_height: f32,
 }
 
 /// What the controller senses of its bodies this tick.
@@ -94,56 +155,67 @@ struct Sensed {
     body_rotation: Quat,
     body_velocity: Vec3,
     body_spin: Vec3,
-    leg_spin: Vec3,
-    /// Unit vector from hip to foot.
-    leg_axis: Vec3,
-    leg_length: f32,
-    leg_rate: f32,
-    foot_height: f32,
+    legs: [LegSensed; MAX_LEGS],
 }
 
 impl Sensed {
     /// Finite and not absurdly fast: anything else is a blow-up, handled as a fall.
-    fn is_sane(&self, blow_up_speed_m_per_s: f32) -> bool {
+    fn is_sane(&self, legs: usize, blow_up_speed_m_per_s: f32) -> bool {
+        let legs_finite = self.legs[..legs]
+            .iter()
+            .all(|l| l.spin.is_finite() && l.axis.is_finite() && l.rate.is_finite() && l.foot_height.is_finite());
         let finite = self.body_velocity.is_finite()
             && self.body_spin.is_finite()
-            && self.leg_spin.is_finite()
-            && self.leg_axis.is_finite()
-            && self.leg_rate.is_finite()
-            && self.foot_height.is_finite()
-            && self.body_rotation.is_finite();
+            && self.body_rotation.is_finite()
+            && legs_finite;
         finite && self.body_velocity.length() < blow_up_speed_m_per_s
     }
 
-    fn read(hopper: &RigidHopper, parts: &Query<(&mut Transform, &mut Velocity, &mut ExternalForce)>) -> Option<Self> {
-        let (body, body_v, _) = parts.get(hopper.body).ok()?;
-        let (_, leg_v, _) = parts.get(hopper.upper_leg).ok()?;
-        let (foot, foot_v, _) = parts.get(hopper.lower_leg).ok()?;
-        let to_foot = foot.translation - body.translation;
-        let leg_length = to_foot.length();
-        let leg_axis = to_foot / leg_length.max(1e-6);
+    fn read(
+        bodies: &RigidBodies,
+        hips: &[Vec3],
+        parts: &Query<(&mut Transform, &mut Velocity, &mut ExternalForce), With<RigidPart>>,
+    ) -> Option<Self> {
+        let (body, body_v, _) = parts.get(bodies.body).ok()?;
+        let mut legs = [LegSensed::default(); MAX_LEGS];
+        for ((sensed, leg), hip) in legs.iter_mut().zip(&bodies.legs).zip(hips) {
+            let (_, upper_v, _) = parts.get(leg.upper).ok()?;
+            let (foot, foot_v, _) = parts.get(leg.lower).ok()?;
+            let hip_offset = body.rotation * *hip;
+            let to_foot = foot.translation - (body.translation + hip_offset);
+            let length = to_foot.length();
+            let axis = to_foot / length.max(1e-6);
+            let hip_velocity = body_v.linear + body_v.angular.cross(hip_offset);
+            *sensed = LegSensed {
+                spin: upper_v.angular,
+                axis,
+                length,
+                rate: (foot_v.linear - hip_velocity).dot(axis),
+                foot_height: foot.translation.y,
+            };
+        }
         Some(Self {
             body_rotation: body.rotation,
             body_velocity: body_v.linear,
             body_spin: body_v.angular,
-            leg_spin: leg_v.angular,
-            leg_axis,
-            leg_length,
-            leg_rate: (foot_v.linear - body_v.linear).dot(leg_axis),
-            foot_height: foot.translation.y,
+            legs,
         })
+    }
+
+    fn on_ground(&self, leg: usize, config: &LegConfig) -> bool {
+        self.legs[leg].foot_height <= config.foot_radius_m + FOOT_CONTACT_TOLERANCE_M
     }
 }
 
-/// Torques for one tick: on the body and on the upper leg.
+/// Torques for one tick: on the body and on each upper leg.
 struct Torques {
     body: Vec3,
-    leg: Vec3,
+    legs: [Vec3; MAX_LEGS],
 }
 
-/// The leg spring's push along the leg (foot away from hip), from its rest length `target`.
-fn spring_force(s: &Sensed, r: &RigidConfig, target: f32) -> f32 {
-    r.leg_spring_n_per_m * (target - s.leg_length) - r.leg_damping_n_s_per_m * s.leg_rate
+/// A leg spring's push along the leg (foot away from hip), from its rest length `target`.
+fn spring_force(s: &LegSensed, leg: &LegConfig, target: f32) -> f32 {
+    leg.spring_n_per_m * (target - s.length) - leg.damping_n_s_per_m * s.rate
 }
 
 /// Yaw of a rotation about world up: the angle of its forward (+x) axis from +x toward -z.
@@ -157,11 +229,18 @@ fn wrap_angle(a: f32) -> f32 {
 }
 
 impl Raibert {
-    /// Advances the stance/flight state machine; returns the spring rest length to aim at.
-    fn update_phase(&mut self, s: &Sensed, r: &RigidConfig, desired: Vec2, now: f32) -> f32 {
-        let on_ground = s.foot_height <= r.foot_radius_m + FOOT_CONTACT_TOLERANCE_M;
+    /// Advances the stance/flight state machine on the legs' contacts.
+    fn update_phase(&mut self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, now: f32) {
+        let (legs, together) = (kind.legs.len(), kind.steps_per_stride == 1);
+        let on_ground = |i: usize| s.on_ground(i, &kind.legs[i]);
+        let stance_leg = &s.legs[self.stance_leg];
         match self.phase {
-            StancePhase::Flight if on_ground => {
+            StancePhase::Flight => {
+                // The leg due to land first; any other that meets the ground instead takes over.
+                let landing = self.landing_leg(legs, together);
+                let Some(touched) = (0..legs).map(|k| (landing + k) % legs).find(|&i| on_ground(i)) else {
+                    return;
+                };
                 let flight = now - self.last_liftoff_s;
                 let c = &r.controller;
                 self.thrust_m =
@@ -174,95 +253,139 @@ impl Raibert {
                         .clamp_length_max(c.max_speed_correction_m_per_s);
                 }
                 self.last_touchdown_s = now;
+                self.stance_leg = touched;
                 self.phase = StancePhase::Compression;
             }
-            StancePhase::Compression if s.leg_rate >= 0.0 && s.leg_length < r.leg_rest_length_m => {
+            StancePhase::Compression
+                if stance_leg.rate >= 0.0 && stance_leg.length < kind.legs[self.stance_leg].rest_length_m =>
+            {
                 self.phase = StancePhase::Thrust;
             }
-            StancePhase::Compression | StancePhase::Thrust if !on_ground => {
+            StancePhase::Compression | StancePhase::Thrust
+                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i)) =>
+            {
                 self.stance_s = 0.5 * self.stance_s + 0.5 * (now - self.last_touchdown_s).clamp(0.05, 0.5);
                 self.last_liftoff_s = now;
                 self.phase = StancePhase::Flight;
             }
             _ => {}
         }
-        match self.phase {
-            StancePhase::Thrust => r.leg_rest_length_m + self.thrust_m,
-            _ => r.leg_rest_length_m,
+    }
+
+    /// The spring rest length a leg in `role` aims at this tick.
+    fn spring_target(&self, leg: &LegConfig, r: &RigidConfig, role: Role) -> f32 {
+        match role {
+            Role::Stance if self.phase == StancePhase::Thrust => leg.rest_length_m + self.thrust_m,
+            Role::Stance | Role::Landing => leg.rest_length_m,
+            Role::Idle => (leg.rest_length_m - r.controller.idle_leg_retract_m).max(leg.min_length_m),
         }
     }
 
-    fn torques(&self, s: &Sensed, r: &RigidConfig, desired: Vec2, dt: f32) -> Torques {
+    fn torques(&self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, dt: f32) -> Torques {
         let c = &r.controller;
-        let relative_spin = s.leg_spin - s.body_spin;
-        let twist_inertia = 0.5 * (r.upper_leg_mass_kg + r.lower_leg_mass_kg) * r.leg_radius_m * r.leg_radius_m;
-        let twist = s.leg_axis * (relative_spin.dot(s.leg_axis) * twist_inertia * TWIST_DAMPING_PER_TICK / dt);
-        match self.phase {
-            StancePhase::Flight => {
-                // Foot placement: neutral point plus the speed correction.
-                let v = s.body_velocity.xz();
-                let reach = c.max_foot_offset_fraction * s.leg_length;
-                let command = desired.try_normalize().map_or(desired, |along| {
-                    desired + along * self.speed_correction.x + along.perp() * self.speed_correction.y
-                });
-                let offset = (v * (self.stance_s / 2.0) + (v - command) * c.speed_gain_s).clamp_length_max(reach);
-                let down = (s.leg_length * s.leg_length - offset.length_squared()).sqrt();
-                let aim = Vec3::new(offset.x, -down, offset.y).normalize_or(Vec3::NEG_Y);
-                let swing_rate = relative_spin - s.leg_axis * relative_spin.dot(s.leg_axis);
-                let tau = s.leg_axis.cross(aim) * c.swing_kp_nm_per_rad - swing_rate * c.swing_kd_nm_s_per_rad - twist;
-                Torques { body: -tau, leg: tau }
-            }
-            StancePhase::Compression | StancePhase::Thrust => {
-                let up = s.body_rotation * Vec3::Y;
-                let level = up.cross(Vec3::Y) * c.attitude_kp_nm_per_rad
-                    - Vec3::new(s.body_spin.x, 0.0, s.body_spin.z) * c.attitude_kd_nm_s_per_rad;
-                let yaw = yaw_of(s.body_rotation);
-                let wanted = if desired.length() > c.turn_min_speed_m_per_s {
-                    (-desired.y).atan2(desired.x)
-                } else {
-                    yaw
-                };
-                let yaw_error = wrap_angle(wanted - yaw).clamp(-c.max_yaw_error_rad, c.max_yaw_error_rad);
-                let turn = (yaw_error * c.yaw_kp_nm_per_rad - s.body_spin.y * c.yaw_kd_nm_s_per_rad)
-                    .clamp(-c.yaw_max_torque_nm, c.yaw_max_torque_nm);
-                Torques {
-                    body: level + Vec3::Y * turn + twist,
-                    leg: -level - twist,
+        let (legs, together) = (kind.legs.len(), kind.steps_per_stride == 1);
+        let mut out = Torques {
+            body: Vec3::ZERO,
+            legs: [Vec3::ZERO; MAX_LEGS],
+        };
+        // Foot placement: neutral point plus the speed correction.
+        let v = s.body_velocity.xz();
+        let command = desired.try_normalize().map_or(desired, |along| {
+            desired + along * self.speed_correction.x + along.perp() * self.speed_correction.y
+        });
+        let placement = v * (self.stance_s / 2.0) + (v - command) * c.speed_gain_s;
+        // The leg the idle ones mirror: the one in stance, or the one about to land.
+        let active = match self.phase {
+            StancePhase::Flight => self.landing_leg(legs, together),
+            _ => self.stance_leg,
+        };
+        let stance_legs = if together { legs as f32 } else { 1.0 };
+        let mut stance_body = Vec3::ZERO;
+        for (i, (sensed, leg)) in s.legs.iter().zip(&kind.legs).enumerate() {
+            let relative_spin = sensed.spin - s.body_spin;
+            let twist_inertia = 0.5 * (leg.upper_mass_kg + leg.lower_mass_kg) * leg.radius_m * leg.radius_m;
+            let twist = sensed.axis * (relative_spin.dot(sensed.axis) * twist_inertia * TWIST_DAMPING_PER_TICK / dt);
+            let swing_to = |aim: Vec3| {
+                let swing_rate = relative_spin - sensed.axis * relative_spin.dot(sensed.axis);
+                sensed.axis.cross(aim) * c.swing_kp_nm_per_rad - swing_rate * c.swing_kd_nm_s_per_rad - twist
+            };
+            let tau = match self.role(i, legs, together) {
+                Role::Landing => {
+                    let reach = c.max_foot_offset_fraction * sensed.length;
+                    let offset = placement.clamp_length_max(reach);
+                    let down = (sensed.length * sensed.length - offset.length_squared()).sqrt();
+                    swing_to(Vec3::new(offset.x, -down, offset.y).normalize_or(Vec3::NEG_Y))
                 }
-            }
+                Role::Idle => {
+                    let a = s.legs[active].axis;
+                    swing_to(Vec3::new(-a.x, a.y, -a.z).normalize_or(Vec3::NEG_Y))
+                }
+                Role::Stance => {
+                    stance_body += twist;
+                    out.legs[i] = -attitude_level(s, c) / stance_legs - twist;
+                    continue;
+                }
+            };
+            out.body -= tau;
+            out.legs[i] = tau;
         }
+        if self.phase != StancePhase::Flight {
+            let yaw = yaw_of(s.body_rotation);
+            let wanted = if desired.length() > c.turn_min_speed_m_per_s {
+                (-desired.y).atan2(desired.x)
+            } else {
+                yaw
+            };
+            let yaw_error = wrap_angle(wanted - yaw).clamp(-c.max_yaw_error_rad, c.max_yaw_error_rad);
+            let turn = (yaw_error * c.yaw_kp_nm_per_rad - s.body_spin.y * c.yaw_kd_nm_s_per_rad)
+                .clamp(-c.yaw_max_torque_nm, c.yaw_max_torque_nm);
+            out.body += attitude_level(s, c) + Vec3::Y * turn + stance_body;
+        }
+        out
     }
 }
 
-pub(super) fn control_hoppers(
+/// The stance hip torque that holds the body level (pitch and roll).
+fn attitude_level(s: &Sensed, c: &crate::config::RaibertConfig) -> Vec3 {
+    let up = s.body_rotation * Vec3::Y;
+    up.cross(Vec3::Y) * c.attitude_kp_nm_per_rad
+        - Vec3::new(s.body_spin.x, 0.0, s.body_spin.z) * c.attitude_kd_nm_s_per_rad
+}
+
+pub(super) fn control_legs(
     clock: Res<SimClock>,
     kinds: Res<KindTable>,
     falls: Res<FallQueue>,
     mut commands: Commands,
-    mut hoppers: Query<(
-        Entity,
-        &Creature,
-        &RigidHopper,
-        &PlanarState,
-        &DesiredVelocity,
-        &mut Raibert,
-        Option<&Shove>,
-    )>,
-    mut parts: Query<(&mut Transform, &mut Velocity, &mut ExternalForce)>,
+    mut creatures: Query<
+        (
+            Entity,
+            &Creature,
+            &RigidBodies,
+            &PlanarState,
+            &DesiredVelocity,
+            &mut Raibert,
+            Option<&Shove>,
+        ),
+        With<AtRigid>,
+    >,
+    mut parts: Query<(&mut Transform, &mut Velocity, &mut ExternalForce), With<RigidPart>>,
 ) {
     let now = clock.seconds() as f32;
-    for (entity, creature, hopper, state, desired, mut raibert, shove) in &mut hoppers {
-        let Some(r) = &kinds[creature.kind].rigid else { continue };
-        let Some(sensed) = Sensed::read(hopper, &parts) else {
+    for (entity, creature, bodies, state, desired, mut raibert, shove) in &mut creatures {
+        let kind = &kinds[creature.kind];
+        let Some(r) = &kind.rigid else { continue };
+        let Some(sensed) = Sensed::read(bodies, &kind.hips_m, &parts) else {
             continue;
         };
-        if !sensed.is_sane(r.fall.blow_up_speed_m_per_s) {
+        if !sensed.is_sane(kind.legs.len(), r.fall.blow_up_speed_m_per_s) {
             // Calm the bodies so the physics step survives until the fall removes them.
             falls.push(creature.serial, entity);
-            for part in hopper.parts() {
+            for part in bodies.parts() {
                 if let Ok((mut transform, mut velocity, mut force)) = parts.get_mut(part) {
                     if !transform.is_finite() {
-                        *transform = Transform::from_xyz(state.position.x, r.leg_rest_length_m, state.position.y);
+                        *transform =
+                            Transform::from_xyz(state.position.x, kind.standing_pose.body_height_m, state.position.y);
                     }
                     *velocity = Velocity::zero();
                     *force = ExternalForce::default();
@@ -270,25 +393,33 @@ pub(super) fn control_hoppers(
             }
             continue;
         }
-        let kind = &kinds[creature.kind];
         let step = (desired.0 - raibert.command).clamp_length_max(kind.command_acceleration_m_per_s2 * clock.dt);
         raibert.command += step;
         let command = raibert.command;
-        let target = raibert.update_phase(&sensed, r, command, now);
-        let push = sensed.leg_axis * spring_force(&sensed, r, target);
-        let torques = raibert.torques(&sensed, r, command, clock.dt);
+        raibert.update_phase(&sensed, kind, r, command, now);
+        let torques = raibert.torques(&sensed, kind, r, command, clock.dt);
         let shove_force = shove.map_or(Vec3::ZERO, |s| {
             commands.entity(entity).remove::<Shove>();
             s.0 / clock.dt
         });
-        let actuation = [
-            (hopper.body, shove_force, torques.body),
-            (hopper.upper_leg, -push, torques.leg),
-            (hopper.lower_leg, push, Vec3::ZERO),
-        ];
-        for (part, force, torque) in actuation {
-            if let Ok((_, _, mut f)) = parts.get_mut(part) {
-                *f = ExternalForce { force, torque };
+        if let Ok((_, _, mut f)) = parts.get_mut(bodies.body) {
+            *f = ExternalForce {
+                force: shove_force,
+                torque: torques.body,
+            };
+        }
+        let together = kind.steps_per_stride == 1;
+        for (i, (leg_bodies, leg)) in bodies.legs.iter().zip(&kind.legs).enumerate() {
+            let role = raibert.role(i, kind.legs.len(), together);
+            let sensed_leg = &sensed.legs[i];
+            let push = sensed_leg.axis * spring_force(sensed_leg, leg, raibert.spring_target(leg, r, role));
+            for (part, force, torque) in [
+                (leg_bodies.upper, -push, torques.legs[i]),
+                (leg_bodies.lower, push, Vec3::ZERO),
+            ] {
+                if let Ok((_, _, mut f)) = parts.get_mut(part) {
+                    *f = ExternalForce { force, torque };
+                }
             }
         }
     }

@@ -1,10 +1,14 @@
-//! The rigid-body level (paper section 3.1, figure 2): the one-legged hopper as three rapier
-//! bodies on a multibody (reduced-coordinate) joint tree, driven by Raibert's controller.
+//! The rigid-body level (paper section 3.1, figure 2): a body box on the kind's legs, as
+//! rapier bodies on one multibody (reduced-coordinate) joint tree, driven by Raibert's
+//! controller.
 //!
-//! Body on a three-axis hip (spherical joint) to the upper leg; the lower leg telescopes on a
-//! springy prismatic joint and ends in a ball foot that meets the ground through rapier
-//! contact. The creature entity keeps the state every level shares ([`PlanarState`],
-//! [`GaitPhase`]); its bodies are separate entities listed in [`RigidHopper`], removed with it.
+//! Each leg: an upper leg on a three-axis hip (spherical joint) where the leg's hip sits on the
+//! body, and a lower leg that telescopes on a springy prismatic joint and ends in a ball foot
+//! that meets the ground through rapier contact. The creature entity keeps the state every
+//! level shares ([`PlanarState`], [`GaitPhase`], [`GaitPose`]); its bodies are separate
+//! entities listed in [`RigidBodies`]. The level is entered and left through its marker
+//! [`AtRigid`]: adding it builds the bodies and the controller, removing it (a switch down,
+//! or the creature's removal) takes them away.
 
 mod controller;
 
@@ -14,24 +18,32 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::arena::{Ground, Puck, Wall};
-use crate::config::RigidConfig;
+use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
 use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState};
-use crate::gait::GaitPose;
-use crate::lod::Lod;
+use crate::gait::{GaitPose, LegPose};
+use crate::lod::AtRigid;
 use crate::outcome::{CollisionRecord, FallQueue, Obstacle};
 use crate::{SimClock, SimStage};
 
-/// The rapier bodies of a rigid creature.
-#[derive(Component, Clone, Copy, Debug)]
-pub struct RigidHopper {
-    pub body: Entity,
-    pub upper_leg: Entity,
-    pub lower_leg: Entity,
+/// The rapier bodies of one leg.
+#[derive(Clone, Copy, Debug)]
+pub struct LegBodies {
+    pub upper: Entity,
+    /// The telescoping lower leg, its ball foot at its end.
+    pub lower: Entity,
 }
 
-impl RigidHopper {
-    pub fn parts(&self) -> [Entity; 3] {
-        [self.body, self.upper_leg, self.lower_leg]
+/// The rapier bodies of a rigid creature: its body, then its legs in the kind's order.
+#[derive(Component, Clone, Debug)]
+pub struct RigidBodies {
+    pub body: Entity,
+    pub legs: Vec<LegBodies>,
+}
+
+impl RigidBodies {
+    /// Every part, the body first.
+    pub fn parts(&self) -> impl DoubleEndedIterator<Item = Entity> + '_ {
+        std::iter::once(self.body).chain(self.legs.iter().flat_map(|l| [l.upper, l.lower]))
     }
 }
 
@@ -45,22 +57,22 @@ pub struct RigidPart {
 /// applies (rapier 0.35.0's force-based motors blow up on multibody links). Rapier builds a
 /// multibody from joint coordinates, not from where the bodies stand, so the joint's zero is
 /// put at the leg's rest length: coordinate = length - rest length.
-fn leg_joint(r: &RigidConfig) -> PrismaticJoint {
-    let rest = r.leg_rest_length_m;
+fn leg_joint(leg: &LegConfig, r: &RigidConfig) -> PrismaticJoint {
+    let rest = leg.rest_length_m;
     let mut joint = PrismaticJointBuilder::new(Vec3::NEG_Y)
         .local_anchor1(Vec3::ZERO)
         .local_anchor2(Vec3::Y * rest)
-        .limits([r.leg_min_length_m - rest, leg_length_range_m(r).1 - rest])
+        .limits([leg.min_length_m - rest, leg_length_range_m(leg, r).1 - rest])
         .build();
     joint.set_contacts_enabled(false);
     joint
 }
 
-/// The leg's shortest and longest length: its stops, a little past the longest thrust.
-fn leg_length_range_m(r: &RigidConfig) -> (f32, f32) {
+/// A leg's shortest and longest length: its stops, a little past the longest thrust.
+fn leg_length_range_m(leg: &LegConfig, r: &RigidConfig) -> (f32, f32) {
     (
-        r.leg_min_length_m,
-        r.leg_rest_length_m + r.controller.thrust_max_m + LEG_STOP_BEYOND_THRUST_M,
+        leg.min_length_m,
+        leg.rest_length_m + r.controller.thrust_max_m + LEG_STOP_BEYOND_THRUST_M,
     )
 }
 
@@ -86,103 +98,112 @@ fn part(creature: Entity, transform: Transform) -> impl Bundle {
 /// so both are applied to its coordinates once it exists, then this is removed.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct RigidStart {
-    /// The leg's rotation from hanging straight down, in the body's frame (scaled axis).
-    pub hip_rotation: Vec3,
-    /// The leg's length past its rest length (the prismatic joint's coordinate).
-    pub leg_extension_m: f32,
+    /// Each leg's rotation from hanging straight down, in the body's frame (scaled axis).
+    pub hip_rotations: [Vec3; MAX_LEGS],
+    /// Each leg's length past its rest length (its prismatic joint's coordinate).
+    pub leg_extensions_m: [f32; MAX_LEGS],
     pub velocity: Vec3,
 }
 
 /// Builds the bodies of a creature at the rigid level in `pose`, facing its heading at its
-/// planar position, the hip at the pose's body height.
-pub fn spawn_hopper(
+/// planar position, the body's centre at the pose's body height.
+pub fn spawn_bodies(
     commands: &mut Commands,
     creature: Entity,
+    kind: &KindParams,
     r: &RigidConfig,
-    mass_kg: f32,
     state: &PlanarState,
     pose: &GaitPose,
-) -> RigidHopper {
+) -> RigidBodies {
     let body_rotation = pose.body_rotation(state.heading);
-    let leg_rotation = body_rotation * pose.hip_rotation();
-    let hip = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
-    let foot = hip + leg_rotation * Vec3::NEG_Y * pose.leg_length_m;
+    let centre = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
     let (hx, hy, hz) = r.body_half_extents_m;
     let body = commands
         .spawn((
-            Name::new("hopper body"),
-            part(creature, Transform::from_translation(hip).with_rotation(body_rotation)),
+            Name::new("creature body"),
+            part(
+                creature,
+                Transform::from_translation(centre).with_rotation(body_rotation),
+            ),
             Collider::cuboid(hx, hy, hz),
-            ColliderMassProperties::Mass(mass_kg),
+            ColliderMassProperties::Mass(kind.mass_kg),
         ))
         .id();
-    let upper_len = r.upper_leg_length_m;
-    let mut hip_joint = SphericalJointBuilder::new()
-        .local_anchor1(Vec3::ZERO)
-        .local_anchor2(Vec3::ZERO)
-        .build();
-    hip_joint.set_contacts_enabled(false);
-    let upper_leg = commands
-        .spawn((
-            Name::new("hopper upper leg"),
-            part(creature, Transform::from_translation(hip).with_rotation(leg_rotation)),
-            Collider::compound(vec![(
-                Vec3::new(0.0, -upper_len / 2.0, 0.0),
-                Quat::IDENTITY,
-                Collider::capsule_y(upper_len / 2.0 - r.leg_radius_m, r.leg_radius_m),
-            )]),
-            ColliderMassProperties::Mass(r.upper_leg_mass_kg),
-            MultibodyJoint::new(body, hip_joint.into()),
-        ))
-        .id();
-    let shank = r.lower_leg_length_m - r.foot_radius_m;
-    let lower_leg = commands
-        .spawn((
-            Name::new("hopper lower leg"),
-            part(creature, Transform::from_translation(foot).with_rotation(leg_rotation)),
-            Collider::compound(vec![
-                (Vec3::ZERO, Quat::IDENTITY, Collider::ball(r.foot_radius_m)),
-                (
-                    Vec3::new(0.0, r.foot_radius_m + shank / 2.0, 0.0),
-                    Quat::IDENTITY,
-                    Collider::capsule_y((shank / 2.0 - r.leg_radius_m * 0.8).max(0.01), r.leg_radius_m * 0.8),
-                ),
-            ]),
-            ColliderMassProperties::Mass(r.lower_leg_mass_kg),
-            Friction {
-                coefficient: r.foot_friction,
-                combine_rule: CoefficientCombineRule::Max,
-            },
-            MultibodyJoint::new(upper_leg, leg_joint(r).into()),
-        ))
-        .id();
-    RigidHopper {
-        body,
-        upper_leg,
-        lower_leg,
-    }
+    let legs = kind
+        .legs
+        .iter()
+        .zip(&kind.hips_m)
+        .zip(pose.legs())
+        .map(|((leg, &hip_at), leg_pose)| {
+            let leg_rotation = body_rotation * leg_pose.hip_rotation();
+            let hip = centre + body_rotation * hip_at;
+            let foot = hip + leg_rotation * Vec3::NEG_Y * leg_pose.length_m;
+            let mut hip_joint = SphericalJointBuilder::new()
+                .local_anchor1(hip_at)
+                .local_anchor2(Vec3::ZERO)
+                .build();
+            hip_joint.set_contacts_enabled(false);
+            let upper_len = leg.upper_length_m;
+            let upper = commands
+                .spawn((
+                    Name::new("creature upper leg"),
+                    part(creature, Transform::from_translation(hip).with_rotation(leg_rotation)),
+                    Collider::compound(vec![(
+                        Vec3::new(0.0, -upper_len / 2.0, 0.0),
+                        Quat::IDENTITY,
+                        Collider::capsule_y(upper_len / 2.0 - leg.radius_m, leg.radius_m),
+                    )]),
+                    ColliderMassProperties::Mass(leg.upper_mass_kg),
+                    MultibodyJoint::new(body, hip_joint.into()),
+                ))
+                .id();
+            let shank = leg.lower_length_m - leg.foot_radius_m;
+            let lower = commands
+                .spawn((
+                    Name::new("creature lower leg"),
+                    part(creature, Transform::from_translation(foot).with_rotation(leg_rotation)),
+                    Collider::compound(vec![
+                        (Vec3::ZERO, Quat::IDENTITY, Collider::ball(leg.foot_radius_m)),
+                        (
+                            Vec3::new(0.0, leg.foot_radius_m + shank / 2.0, 0.0),
+                            Quat::IDENTITY,
+                            Collider::capsule_y((shank / 2.0 - leg.radius_m * 0.8).max(0.01), leg.radius_m * 0.8),
+                        ),
+                    ]),
+                    ColliderMassProperties::Mass(leg.lower_mass_kg),
+                    Friction {
+                        coefficient: leg.foot_friction,
+                        combine_rule: CoefficientCombineRule::Max,
+                    },
+                    MultibodyJoint::new(upper, leg_joint(leg, r).into()),
+                ))
+                .id();
+            LegBodies { upper, lower }
+        })
+        .collect();
+    RigidBodies { body, legs }
 }
 
-/// The body and leg pose of a rigid hopper, in the frame of its heading.
-pub fn rigid_pose(body: &Transform, foot: &Transform) -> GaitPose {
-    let (_, pitch, roll) = body.rotation.to_euler(EulerRot::YZX);
-    let to_foot = foot.translation - body.translation;
-    let leg = body.rotation.inverse() * to_foot;
-    GaitPose {
-        body_height_m: body.translation.y,
-        roll_rad: roll,
-        pitch_rad: pitch,
-        leg_length_m: to_foot.length(),
-        leg_forward_rad: leg.x.atan2(-leg.y),
-        leg_sideways_rad: (-leg.z).atan2(-leg.y),
+/// The pose of a rigid creature's bodies, in the frame of its heading.
+fn pose_of(
+    bodies: &RigidBodies,
+    hips: &[Vec3],
+    parts: &Query<(&Transform, &Velocity, &CollidingEntities)>,
+) -> Option<GaitPose> {
+    let (body, _, _) = parts.get(bodies.body).ok()?;
+    let mut feet = [Vec3::ZERO; MAX_LEGS];
+    for (foot, leg) in feet.iter_mut().zip(&bodies.legs) {
+        *foot = parts.get(leg.lower).ok()?.0.translation;
     }
+    Some(GaitPose::of_bodies(body, hips, feet))
 }
 
 /// The pose a creature enters the rigid level in (paper 3.4: the motion continues): in
-/// flight, the gait table's for its speed and hop phase where its kind has one; else (no
+/// flight, the gait table's for its speed and stride phase where its kind has one; else (no
 /// table, or on the ground: a new creature, or a switch forced by a collision) upright at the
-/// height its level last had; the hip raised if need be so the foot starts clear of the
-/// ground. Also the body's vertical velocity, from the table's change of height over the hop.
+/// height its level last had, the legs at rest length; the body raised if need be so every
+/// foot starts clear of the ground. Also the body's vertical velocity, from the table's change
+/// of height over the stride.
 fn entry_pose(
     kind: &KindParams,
     r: &RigidConfig,
@@ -195,90 +216,112 @@ fn entry_pose(
         // In flight, as a switch in the flight window is; the controller starts in flight.
         Some(table) if gait.in_flight => {
             let (period, _) = table.rhythm(speed);
-            let step = 1.0 / (table.sample_hz * period);
-            let (now, next) = (table.pose(speed, gait.cycle), table.pose(speed, gait.cycle + step));
+            let steps = kind.steps_per_stride as f32;
+            let stride = gait.stride(kind.steps_per_stride);
+            let sample = 1.0 / (table.sample_hz * period * steps);
+            let (now, next) = (table.pose(speed, stride), table.pose(speed, stride + sample));
             (now, (next.body_height_m - now.body_height_m) * table.sample_hz)
         }
-        // Else the body where the lower level had it, the leg hanging at rest.
-        _ => (
-            GaitPose {
-                body_height_m: last.body_height_m,
-                leg_length_m: r.leg_rest_length_m,
-                ..default()
-            },
-            0.0,
-        ),
+        // Else the body where the lower level had it, the legs hanging at rest.
+        _ => {
+            let legs: Vec<LegPose> = kind.legs.iter().map(|l| LegPose::straight(l.rest_length_m)).collect();
+            (GaitPose::new(last.body_height_m, 0.0, 0.0, &legs), 0.0)
+        }
     };
-    let (shortest, longest) = leg_length_range_m(r);
-    pose.leg_length_m = pose.leg_length_m.clamp(shortest, longest);
-    let foot_drop = -(pose.body_rotation(state.heading) * pose.leg_direction()).y * pose.leg_length_m;
-    pose.body_height_m = pose
-        .body_height_m
-        .max(foot_drop + r.foot_radius_m + FOOT_START_CLEARANCE_M);
-    let start = RigidStart {
-        hip_rotation: pose.hip_rotation().to_scaled_axis(),
-        leg_extension_m: pose.leg_length_m - r.leg_rest_length_m,
+    let rotation = pose.body_rotation(state.heading);
+    let mut lowest_foot: f32 = 0.0;
+    for ((leg_pose, leg), hip) in pose.legs_mut().iter_mut().zip(&kind.legs).zip(&kind.hips_m) {
+        let (shortest, longest) = leg_length_range_m(leg, r);
+        leg_pose.length_m = leg_pose.length_m.clamp(shortest, longest);
+        let foot_drop = -(rotation * (*hip + leg_pose.direction() * leg_pose.length_m)).y;
+        lowest_foot = lowest_foot.max(foot_drop + leg.foot_radius_m + FOOT_START_CLEARANCE_M);
+    }
+    pose.body_height_m = pose.body_height_m.max(lowest_foot);
+    let mut start = RigidStart {
+        hip_rotations: [Vec3::ZERO; MAX_LEGS],
+        leg_extensions_m: [0.0; MAX_LEGS],
         velocity: Vec3::new(state.velocity.x, climb, state.velocity.y),
     };
+    for (i, (leg_pose, leg)) in pose.legs().iter().zip(&kind.legs).enumerate() {
+        start.hip_rotations[i] = leg_pose.hip_rotation().to_scaled_axis();
+        start.leg_extensions_m[i] = leg_pose.length_m - leg.rest_length_m;
+    }
     (pose, start)
 }
 
-/// Gap left under the foot of a hopper that starts with its foot below the ground.
+/// Gap left under a foot of a creature that starts with its foot below the ground.
 const FOOT_START_CLEARANCE_M: f32 = 0.005;
 
-/// Gives every rigid creature without bodies its bodies and a fresh controller.
-fn build_bodies(
+/// Entering the rigid level: the bodies, in the entry pose, and a controller that resumes the
+/// gait where it was.
+fn enter_rigid(
+    add: On<Add, AtRigid>,
     mut commands: Commands,
     kinds: Res<KindTable>,
     clock: Res<SimClock>,
-    creatures: Query<
-        (Entity, &Creature, &Lod, &PlanarState, &GaitPhase, &GaitPose),
-        (Without<RigidHopper>, Changed<Lod>),
-    >,
+    creatures: Query<(&Creature, &PlanarState, &GaitPhase, &GaitPose)>,
 ) {
-    let now = clock.seconds() as f32;
-    for (entity, creature, lod, state, gait, pose) in &creatures {
-        let kind = &kinds[creature.kind];
-        let (Lod::Rigid, Some(r)) = (lod, &kind.rigid) else {
-            continue;
-        };
-        let (pose, start) = entry_pose(kind, r, state, gait, pose);
-        let hopper = spawn_hopper(&mut commands, entity, r, kind.mass_kg, state, &pose);
-        // The hop resumes where it was.
-        let mut raibert = Raibert::new(r, kind.mass_kg, state.velocity, now);
-        raibert.last_touchdown_s = now - gait.cycle * raibert.hop_period_s;
-        raibert.last_liftoff_s = (raibert.last_touchdown_s + raibert.stance_s).min(now);
-        commands.entity(entity).insert((hopper, raibert, start));
-    }
+    let entity = add.entity;
+    let Ok((creature, state, gait, last)) = creatures.get(entity) else {
+        return;
+    };
+    let kind = &kinds[creature.kind];
+    let Some(r) = &kind.rigid else { return };
+    let (pose, start) = entry_pose(kind, r, state, gait, last);
+    let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose);
+    let controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
+    commands.entity(entity).insert((bodies, controller, start, pose));
 }
 
-/// Puts a new multibody in its entry pose and sets it moving: the hip and leg joints to the
+/// Leaving the rigid level, or the world: the bodies and the controller go.
+fn leave_rigid(remove: On<Remove, AtRigid>, creatures: Query<&RigidBodies>, mut commands: Commands) {
+    let Ok(bodies) = creatures.get(remove.entity) else {
+        return;
+    };
+    for part in bodies.parts().rev() {
+        if let Ok(mut e) = commands.get_entity(part) {
+            e.despawn();
+        }
+    }
+    commands
+        .entity(remove.entity)
+        .try_remove::<(RigidBodies, Raibert, RigidStart)>();
+}
+
+/// Puts a new multibody in its entry pose and sets it moving: each hip and leg joint to the
 /// pose's angles and length, the free root's velocity (which carries the whole tree) to the
 /// body's.
 fn start_multibodies(
     mut commands: Commands,
     mut context: Query<(&mut RapierContextJoints, &mut RapierRigidBodySet)>,
-    new: Query<(Entity, &RigidStart, &RigidHopper)>,
+    new: Query<(Entity, &RigidStart, &RigidBodies)>,
     handles: Query<&RapierMultibodyJointHandle>,
 ) {
     let Ok((mut joints, mut bodies)) = context.single_mut() else {
         return;
     };
-    for (creature, start, hopper) in &new {
+    for (creature, start, parts) in &new {
         commands.entity(creature).remove::<RigidStart>();
-        let Ok(handle) = handles.get(hopper.upper_leg) else {
-            continue;
-        };
-        let Some((multibody, _)) = joints.multibody_joints.get_mut(handle.0) else {
-            continue;
-        };
-        for link in multibody.links_mut() {
-            match link.joint.ndofs() {
-                3 => link.joint.apply_displacement(&start.hip_rotation.to_array()),
-                1 => link.joint.apply_displacement(&[start.leg_extension_m]),
-                _ => {}
+        let mut displace = |part: Entity, displacement: &[f32]| {
+            if let Ok(handle) = handles.get(part)
+                && let Some((multibody, link)) = joints.multibody_joints.get_mut(handle.0)
+                && let Some(link) = multibody.link_mut(link)
+            {
+                link.joint.apply_displacement(displacement);
             }
+        };
+        for (i, leg) in parts.legs.iter().enumerate() {
+            displace(leg.upper, &start.hip_rotations[i].to_array());
+            displace(leg.lower, &[start.leg_extensions_m[i]]);
         }
+        let Some((multibody, _)) = parts
+            .legs
+            .first()
+            .and_then(|leg| handles.get(leg.upper).ok())
+            .and_then(|handle| joints.multibody_joints.get_mut(handle.0))
+        else {
+            continue;
+        };
         // The root's pose is read from its body, where it was spawned.
         multibody.forward_kinematics(&bodies.bodies, true);
         multibody.update_rigid_bodies(&mut bodies.bodies, true);
@@ -289,55 +332,52 @@ fn start_multibodies(
     }
 }
 
-/// Removes a creature's bodies with it, whether it is despawned or changes level.
-fn remove_bodies(remove: On<Remove, RigidHopper>, hoppers: Query<&RigidHopper>, mut commands: Commands) {
-    if let Ok(hopper) = hoppers.get(remove.entity) {
-        for part in hopper.parts().into_iter().rev() {
-            if let Ok(mut e) = commands.get_entity(part) {
-                e.despawn();
-            }
-        }
-    }
-}
-
 /// Reads the shared state back from the bodies, notes collisions and detects falls.
-fn observe_hoppers(
+fn observe_rigid(
     clock: Res<SimClock>,
     kinds: Res<KindTable>,
     falls: Res<FallQueue>,
-    mut creatures: Query<(
-        Entity,
-        &Creature,
-        &RigidHopper,
-        &Raibert,
-        &mut PlanarState,
-        &mut GaitPhase,
-        &mut GaitPose,
-        &mut CollisionRecord,
-    )>,
+    mut creatures: Query<
+        (
+            Entity,
+            &Creature,
+            &RigidBodies,
+            &Raibert,
+            &mut PlanarState,
+            &mut GaitPhase,
+            &mut GaitPose,
+            &mut CollisionRecord,
+        ),
+        With<AtRigid>,
+    >,
     parts: Query<(&Transform, &Velocity, &CollidingEntities)>,
     obstacles: Query<(Has<Puck>, Has<Wall>, Has<Ground>, Option<&RigidPart>)>,
 ) {
     let now = clock.seconds() as f32;
-    for (entity, creature, hopper, raibert, mut state, mut gait, mut pose, mut record) in &mut creatures {
-        let Some(r) = &kinds[creature.kind].rigid else { continue };
-        let Ok((body, body_velocity, _)) = parts.get(hopper.body) else {
+    for (entity, creature, bodies, raibert, mut state, mut gait, mut pose, mut record) in &mut creatures {
+        let kind = &kinds[creature.kind];
+        let Some(r) = &kind.rigid else { continue };
+        let Ok((body, body_velocity, _)) = parts.get(bodies.body) else {
             continue;
         };
         let forward = body.rotation * Vec3::X;
         state.position = body.translation.xz();
         state.velocity = body_velocity.linear.xz();
         state.heading = forward.xz().try_normalize().unwrap_or(state.heading);
-        *gait = raibert.gait_phase(now);
-        if let Ok((foot, _, _)) = parts.get(hopper.lower_leg) {
-            *pose = rigid_pose(body, foot);
-            // The controller sees a touchdown next tick; the bodies show it now.
-            gait.in_flight &= foot.translation.y > r.foot_radius_m + controller::FOOT_CONTACT_TOLERANCE_M;
+        *gait = raibert.gait_phase(now, kind.steps_per_stride);
+        if let Some(bodies_pose) = pose_of(bodies, &kind.hips_m, &parts) {
+            *pose = bodies_pose;
+        }
+        // The controller sees a touchdown next tick; the bodies show it now.
+        for (leg, config) in bodies.legs.iter().zip(&kind.legs) {
+            if let Ok((foot, _, _)) = parts.get(leg.lower) {
+                gait.in_flight &= foot.translation.y > config.foot_radius_m + controller::FOOT_CONTACT_TOLERANCE_M;
+            }
         }
 
         let mut touching = [false; 3];
         let mut body_on_ground = false;
-        for (i, part) in hopper.parts().into_iter().enumerate() {
+        for (i, part) in bodies.parts().enumerate() {
             let Ok((_, _, colliding)) = parts.get(part) else {
                 continue;
             };
@@ -365,18 +405,14 @@ fn observe_hoppers(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_observer(remove_bodies)
-        .add_systems(
-            FixedUpdate,
-            (build_bodies, controller::control_hoppers)
-                .chain()
-                .in_set(SimStage::Step),
-        )
+    app.add_observer(enter_rigid)
+        .add_observer(leave_rigid)
+        .add_systems(FixedUpdate, controller::control_legs.in_set(SimStage::Step))
         .add_systems(
             FixedUpdate,
             start_multibodies
                 .after(PhysicsSet::SyncBackend)
                 .before(PhysicsSet::StepSimulation),
         )
-        .add_systems(FixedUpdate, observe_hoppers.in_set(SimStage::Observe));
+        .add_systems(FixedUpdate, observe_rigid.in_set(SimStage::Observe));
 }
