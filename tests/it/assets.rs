@@ -136,16 +136,12 @@ fn a_leg_shorter_than_it_is_thick_is_refused() {
     let err = load_error(
         "stub_leg",
         "creatures/hopper.ron",
-        &edited(
-            "creatures/hopper.ron",
-            "upper_leg_length_m: 0.45",
-            "upper_leg_length_m: 0.05",
-        ),
+        &edited("creatures/hopper.ron", "upper_length_m: 0.45", "upper_length_m: 0.05"),
     );
     assert_names(
         &err,
         "creatures/hopper.ron",
-        "rigid.upper_leg_length_m",
+        "legs[0].upper_length_m",
         "longer than it is thick",
     );
 }
