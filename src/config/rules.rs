@@ -15,6 +15,9 @@ pub struct LevelRules {
     pub min_dwell_s: f32,
     /// Start and end of the switching window, as parts of the flight phase.
     pub flight_window: (f32, f32),
+    /// How long what is drawn takes to blend from the old level's motion into the new one's
+    /// after a switch (inertialization); 0 draws the switch as it happens.
+    pub blend_s: f32,
 }
 
 /// Areas of influence (figure 5).
@@ -52,6 +55,7 @@ impl Validate for LevelRules {
         v.non_negative("release_margin_m", self.release_margin_m);
         v.within("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
         v.non_negative("min_dwell_s", self.min_dwell_s);
+        v.within("blend_s", self.blend_s, 0.0, 2.0);
         let (a, b) = self.flight_window;
         v.within("flight_window.0", a, 0.0, 1.0);
         v.within("flight_window.1", b, 0.0, 1.0);

@@ -8,7 +8,7 @@ use std::ops::Index;
 
 use crate::config::{CreatureDef, LegConfig, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable, LegPose};
-use crate::lod::{LevelChoice, Lod};
+use crate::lod::{DrawnBefore, LevelChoice, Lod};
 use crate::outcome::CollisionRecord;
 use crate::{SimEntity, SimStart, WorldRng};
 use std::collections::HashMap;
@@ -23,6 +23,7 @@ use std::collections::HashMap;
     GaitPose,
     DesiredVelocity,
     CollisionRecord,
+    DrawnBefore,
     SimEntity
 )]
 pub struct Creature {

@@ -158,22 +158,6 @@ impl GaitPose {
         pose
     }
 
-    /// Each leg's hip and foot in the world, for a body standing at `position` facing
-    /// `heading`, its hips at `hips` on the body.
-    pub fn hips_and_feet<'a>(
-        &'a self,
-        position: Vec2,
-        heading: Vec2,
-        hips: &'a [Vec3],
-    ) -> impl Iterator<Item = (Vec3, Vec3)> + 'a {
-        let rotation = self.body_rotation(heading);
-        let centre = Vec3::new(position.x, self.body_height_m, position.y);
-        self.legs().iter().zip(hips).map(move |(leg, hip)| {
-            let hip = centre + rotation * *hip;
-            (hip, hip + rotation * leg.direction() * leg.length_m)
-        })
-    }
-
     fn lerp(self, other: Self, t: f32) -> Self {
         let mut pose = Self {
             body_height_m: self.body_height_m + (other.body_height_m - self.body_height_m) * t,

@@ -33,6 +33,8 @@ pub struct LevelChoice {
     pub wanted: Lod,
     /// Simulated time of the last switch (for `min_dwell_s`).
     pub last_switch_s: f32,
+    /// Whether it has switched since it was spawned.
+    pub switched: bool,
 }
 
 /// The camera of the camera rule, on the ground plane. Headless it follows a creature

@@ -12,6 +12,7 @@ mod game;
 mod kinds;
 mod outcome;
 mod player;
+mod pops;
 mod restart;
 mod rigid;
 mod schedule;
