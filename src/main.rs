@@ -304,7 +304,10 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         "creatures that collided with the puck or a wall: {}",
         s.creatures_collided
     );
-    println!("falls: {}, respawns: {}", s.falls, s.respawns);
+    println!(
+        "falls: {} ({} within a step of going rigid), respawns: {}",
+        s.falls, s.falls_after_switch, s.respawns
+    );
     println!("creatures per level at the end: {}", join(&s.levels));
     let mean: Vec<String> = s
         .levels_mean
@@ -319,6 +322,20 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         .chain([format!("total {}", s.switches.total())])
         .collect();
     println!("level switches: {}", switches.join(", "));
+    for p in &s.pops {
+        println!(
+            "  pops {}->{}{}: as drawn {:.2} cm, {:.2} deg, {:.3} m/s; models alone {:.1} cm, {:.1} deg (largest of {})",
+            p.from,
+            p.to,
+            if p.forced { " (forced)" } else { "" },
+            p.metres.max * 100.0,
+            p.degrees.max,
+            p.velocity_m_per_s.max,
+            p.model_metres.max * 100.0,
+            p.model_degrees.max,
+            p.count
+        );
+    }
 }
 
 fn main() -> ExitCode {
