@@ -186,6 +186,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         ..s
     };
     let out = &options.out;
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let (done_path, partial_path) = (out.join("fig10.csv"), out.join("fig10.partial.csv"));
     // What an earlier run of the same plan finished: whole trials only.
     let mut earlier = read_rows(&done_path)?.unwrap_or_default();

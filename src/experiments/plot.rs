@@ -150,7 +150,8 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                 .y_desc(&p.y_label)
                 .label_style(("sans-serif", 14))
                 .axis_desc_style(("sans-serif", 16))
-                .x_label_formatter(&x_fmt);
+                .x_label_formatter(&x_fmt)
+                .y_label_formatter(&|y: &f64| tidy(*y));
             if !p.x_names.is_empty() {
                 mesh.x_labels(p.x_names.len() * 2 + 1);
             }
