@@ -213,7 +213,7 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
         let points = |f: &dyn Fn(&(f32, Vec2, PlanarState)) -> (f32, f32)| -> Vec<(f64, f64)> {
             tr.samples
                 .iter()
-                .map(|s| f(s))
+                .map(f)
                 .map(|(x, y)| (f64::from(x), f64::from(y)))
                 .collect()
         };
