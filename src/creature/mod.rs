@@ -285,14 +285,7 @@ pub fn creature_bundle(
 ) -> (Creature, Lod, PlanarState, GaitPhase, GaitPose) {
     let heading = Vec2::from_angle(rng.0.random_range(-std::f32::consts::PI..std::f32::consts::PI));
     let cycle = rng.0.random_range(0.0..1.0);
-    // In the rhythm and pose its level shows from the first frame: a hybrid's are its table's.
-    let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
-        (Lod::Hybrid, Some(table)) => {
-            let (period, stance) = table.rhythm(0.0);
-            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
-        }
-        _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
-    };
+    let (gait, pose) = starting_gait(level, params, cycle, now_s);
     (
         Creature { kind, serial },
         level,
@@ -301,9 +294,22 @@ pub fn creature_bundle(
             velocity: Vec2::ZERO,
             heading,
         },
-        GaitPhase::at(cycle, hop_period_s, stance_fraction, now_s),
+        gait,
         pose,
     )
+}
+
+/// The rhythm and pose a standing creature starts in at `level`, `cycle` into its hop: what
+/// its level shows from the first frame (a hybrid's are its table's).
+pub fn starting_gait(level: Lod, params: &KindParams, cycle: f32, now_s: f32) -> (GaitPhase, GaitPose) {
+    let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
+        (Lod::Hybrid, Some(table)) => {
+            let (period, stance) = table.rhythm(0.0);
+            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
+        }
+        _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
+    };
+    (GaitPhase::at(cycle, hop_period_s, stance_fraction, now_s), pose)
 }
 
 /// Who stands where while the scenario is being placed: a grid that grows one creature at
@@ -340,7 +346,7 @@ impl Occupancy {
 }
 
 /// Places the scenario's creatures in free parts of the court, numbered from 0.
-fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
+pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let kinds = KindTable::of(&config);
     let mut serials = SerialCounter::default();
     let half = config.arena.half_extents();
