@@ -4,7 +4,8 @@ use super::{Validate, Validator};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// One kind of legged creature (the one-legged hopper, the biped, or a modder's own).
+/// One kind of legged creature (the one-legged hopper, the biped, or a modder's own). Each
+/// number's comment gives the range it is checked against when loaded.
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreatureDef {
@@ -12,27 +13,30 @@ pub struct CreatureDef {
     pub name: String,
     pub body: BodyConfig,
     /// Planar speed limit. A kind with a gait table moves its point mass (hybrid and point-mass
-    /// levels) at the table's measured limits instead (paper 3.2).
+    /// levels) at the table's measured limits instead (paper 3.2). 0.01 to 50 m/s.
     pub top_speed_m_per_s: f32,
     /// How fast the creature may change its velocity: the rigid model's command follows the
     /// desired velocity at this rate; the point mass uses it when there is no gait table.
+    /// 0.01 to 1000 m/s^2.
     pub acceleration_limit_m_per_s2: f32,
-    /// How fast the point mass turns its body to face its direction of travel.
+    /// How fast the point mass turns its body to face its direction of travel; 1 to 36,000
+    /// degrees/s.
     pub turn_rate_deg_per_s: f32,
-    /// Touchdown to touchdown.
+    /// Touchdown to touchdown; 0.05 to 10 s.
     pub hop_period_s: f32,
-    /// Part of the hop cycle spent in the air, after stance (0..1).
+    /// Part of the hop cycle spent in the air, after stance; 0.05 to 0.95.
     pub flight_fraction: f32,
     /// At the point-mass level there is no balance to lose: a creature falls when an impact's
-    /// normal speed exceeds this.
+    /// normal speed exceeds this. 0.01 to 1000 m/s.
     pub fall_impact_speed_m_per_s: f32,
-    /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop).
+    /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop); 0
+    /// to 1.
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
     /// The rigid-body model (paper 3.1); a kind without one is never simulated rigid.
     #[serde(default)]
     pub rigid: Option<RigidConfig>,
-    /// The gait table file (relative to the assets folder) the hybrid level plays back
+    /// The gait table file (relative to the assets folder and inside it) the hybrid level plays back
     /// (paper 3.2), written by `simlod record-gait`; a kind without one is never hybrid.
     #[serde(default)]
     pub gait_table: Option<String>,
@@ -114,75 +118,79 @@ pub struct FallConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyConfig {
-    /// Radius of the creature's footprint on the ground: its collision circle.
+    /// Radius of the creature's footprint on the ground: its collision circle; 0.01 to 10 m.
     pub radius_m: f32,
-    /// Height of the hip above the ground while standing.
+    /// Height of the hip above the ground while standing; 0.01 to 20 m.
     pub hip_height_m: f32,
+    /// 0.01 to 10,000 kg.
     pub mass_kg: f32,
 }
 
 /// How the creature picks its desired velocity (paper 3: escape the puck, avoid walls and
-/// other creatures). Weights are relative; the sum is scaled to the top speed.
+/// other creatures). Weights are relative (0 to 1000); the sum is scaled to the top speed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SteeringConfig {
-    /// Speed of undisturbed wandering.
+    /// Speed of undisturbed wandering; 0 to the top speed.
     pub cruise_speed_m_per_s: f32,
-    /// Largest rate at which the wandering heading drifts.
+    /// Largest rate at which the wandering heading drifts; 0 to 100 rad/s.
     pub wander_turn_rad_per_s: f32,
-    /// The creature flees when this close to the puck's path over the look-ahead.
+    /// The creature flees when this close to the puck's path over the look-ahead; 0 to 10,000 m.
     pub puck_alert_distance_m: f32,
-    /// How far ahead the puck's path is predicted.
+    /// How far ahead the puck's path is predicted; 0 to 60 s.
     pub puck_lookahead_s: f32,
     pub puck_weight: f32,
-    /// Walls repel within this distance.
+    /// Walls repel within this distance; 0 to 10,000 m.
     pub wall_avoid_distance_m: f32,
     pub wall_weight: f32,
-    /// Other creatures repel within this distance (centre to centre).
+    /// Other creatures repel within this distance (centre to centre); 0 to 100 m: the
+    /// neighbour grid's cells are this big.
     pub separation_distance_m: f32,
     pub separation_weight: f32,
 }
 
 impl Validate for CreatureDef {
     fn validate(&self, v: &mut Validator) {
-        v.require(
-            !self.name.is_empty()
-                && self
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-'),
-            "name",
-            format!(
-                "must be a non-empty name of letters, digits, '-' or '_', got {:?}",
-                self.name
-            ),
-        );
+        v.kind_name("name", &self.name);
         v.nested("body", |v| {
-            v.positive("radius_m", self.body.radius_m);
-            v.positive("hip_height_m", self.body.hip_height_m);
-            v.positive("mass_kg", self.body.mass_kg);
+            v.range("radius_m", self.body.radius_m, 0.01, 10.0);
+            v.range("hip_height_m", self.body.hip_height_m, 0.01, 20.0);
+            v.range("mass_kg", self.body.mass_kg, 0.01, 10_000.0);
         });
-        v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
-        v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
-        v.positive("turn_rate_deg_per_s", self.turn_rate_deg_per_s);
-        v.positive("hop_period_s", self.hop_period_s);
-        v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
-        v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);
-        v.within("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        v.range("top_speed_m_per_s", self.top_speed_m_per_s, 0.01, 50.0);
+        v.range(
+            "acceleration_limit_m_per_s2",
+            self.acceleration_limit_m_per_s2,
+            0.01,
+            1000.0,
+        );
+        v.range("turn_rate_deg_per_s", self.turn_rate_deg_per_s, 1.0, 36_000.0);
+        v.range("hop_period_s", self.hop_period_s, 0.05, 10.0);
+        v.range("flight_fraction", self.flight_fraction, 0.05, 0.95);
+        v.range(
+            "fall_impact_speed_m_per_s",
+            self.fall_impact_speed_m_per_s,
+            0.01,
+            1000.0,
+        );
+        v.range("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        if let Some(file) = &self.gait_table {
+            v.asset_path("gait_table", file);
+        }
         if let Some(r) = &self.rigid {
             v.nested("rigid", |v| r.validate(v));
         }
         let s = &self.steering;
         v.nested("steering", |v| {
-            v.non_negative("cruise_speed_m_per_s", s.cruise_speed_m_per_s);
-            v.non_negative("wander_turn_rad_per_s", s.wander_turn_rad_per_s);
-            v.non_negative("puck_alert_distance_m", s.puck_alert_distance_m);
-            v.non_negative("puck_lookahead_s", s.puck_lookahead_s);
-            v.non_negative("puck_weight", s.puck_weight);
-            v.non_negative("wall_avoid_distance_m", s.wall_avoid_distance_m);
-            v.non_negative("wall_weight", s.wall_weight);
-            v.non_negative("separation_distance_m", s.separation_distance_m);
-            v.non_negative("separation_weight", s.separation_weight);
+            v.range("cruise_speed_m_per_s", s.cruise_speed_m_per_s, 0.0, 50.0);
+            v.range("wander_turn_rad_per_s", s.wander_turn_rad_per_s, 0.0, 100.0);
+            v.range("puck_alert_distance_m", s.puck_alert_distance_m, 0.0, 10_000.0);
+            v.range("puck_lookahead_s", s.puck_lookahead_s, 0.0, 60.0);
+            v.range("puck_weight", s.puck_weight, 0.0, 1000.0);
+            v.range("wall_avoid_distance_m", s.wall_avoid_distance_m, 0.0, 10_000.0);
+            v.range("wall_weight", s.wall_weight, 0.0, 1000.0);
+            v.range("separation_distance_m", s.separation_distance_m, 0.0, 100.0);
+            v.range("separation_weight", s.separation_weight, 0.0, 1000.0);
             v.require(
                 s.cruise_speed_m_per_s.is_nan() || s.cruise_speed_m_per_s <= self.top_speed_m_per_s,
                 "cruise_speed_m_per_s",

@@ -7,7 +7,7 @@ pub mod record;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::config::{RonAssetLoader, Validate, Validator};
+use crate::config::{RonAssetLoader, Validate, Validator, number};
 
 /// The pose columns of a sample, in order.
 pub const COLUMNS: [&str; 6] = [
@@ -17,6 +17,17 @@ pub const COLUMNS: [&str; 6] = [
     "leg_length_m",
     "leg_forward_rad",
     "leg_sideways_rad",
+];
+
+/// The range each column is checked against: heights and lengths 0 to 20 m, angles within a
+/// half turn.
+const COLUMN_RANGES: [std::ops::RangeInclusive<f32>; 6] = [
+    0.0..=20.0,
+    -std::f32::consts::PI..=std::f32::consts::PI,
+    -std::f32::consts::PI..=std::f32::consts::PI,
+    0.0..=20.0,
+    -std::f32::consts::PI..=std::f32::consts::PI,
+    -std::f32::consts::PI..=std::f32::consts::PI,
 ];
 
 /// A body and leg pose: what the hybrid level draws and the rigid level starts from.
@@ -89,13 +100,14 @@ impl GaitPose {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GaitRow {
-    /// The steady forward speed the rigid model ran at (measured).
+    /// The steady forward speed the rigid model ran at (measured); 0 to 50 m/s.
     pub speed_m_per_s: f32,
-    /// Touchdown to touchdown.
+    /// Touchdown to touchdown; 0.05 to 10 s.
     pub hop_period_s: f32,
-    /// Part of the hop on the ground, from touchdown.
+    /// Part of the hop on the ground, from touchdown; 0 to 1.
     pub stance_fraction: f32,
-    /// Poses from touchdown on, at `sample_hz`; each has the [`COLUMNS`].
+    /// Poses from touchdown on, at `sample_hz`; each has the [`COLUMNS`], heights and lengths
+    /// 0 to 20 m, angles -pi to pi rad.
     pub samples: Vec<Vec<f32>>,
 }
 
@@ -104,10 +116,12 @@ pub struct GaitRow {
 #[serde(deny_unknown_fields)]
 pub struct GaitTable {
     pub creature: String,
+    /// 1 to 1000 Hz.
     pub sample_hz: f32,
     /// The names of a sample's values, in order: must be [`COLUMNS`].
     pub columns: Vec<String>,
-    /// The rigid model's effective limits, which the point mass of the lower levels matches.
+    /// The rigid model's effective limits, which the point mass of the lower levels matches:
+    /// 0.01 to 1000 m/s^2 and 0.01 to 50 m/s.
     pub acceleration_limit_m_per_s2: f32,
     pub top_speed_m_per_s: f32,
     /// In increasing order of speed.
@@ -116,9 +130,14 @@ pub struct GaitTable {
 
 impl Validate for GaitTable {
     fn validate(&self, v: &mut Validator) {
-        v.positive("sample_hz", self.sample_hz);
-        v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
-        v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
+        v.range("sample_hz", self.sample_hz, 1.0, 1000.0);
+        v.range(
+            "acceleration_limit_m_per_s2",
+            self.acceleration_limit_m_per_s2,
+            0.01,
+            1000.0,
+        );
+        v.range("top_speed_m_per_s", self.top_speed_m_per_s, 0.01, 50.0);
         v.require(
             self.columns.iter().map(String::as_str).eq(COLUMNS),
             "columns",
@@ -131,9 +150,9 @@ impl Validate for GaitTable {
         );
         for (i, row) in self.rows.iter().enumerate() {
             v.nested(&format!("rows[{i}]"), |v| {
-                v.non_negative("speed_m_per_s", row.speed_m_per_s);
-                v.positive("hop_period_s", row.hop_period_s);
-                v.within("stance_fraction", row.stance_fraction, 0.0, 1.0);
+                v.range("speed_m_per_s", row.speed_m_per_s, 0.0, 50.0);
+                v.range("hop_period_s", row.hop_period_s, 0.05, 10.0);
+                v.range("stance_fraction", row.stance_fraction, 0.0, 1.0);
                 v.require(!row.samples.is_empty(), "samples", "has no samples");
                 for (j, sample) in row.samples.iter().enumerate() {
                     if sample.len() != COLUMNS.len() {
@@ -146,10 +165,17 @@ impl Validate for GaitTable {
                                 COLUMNS.join(", ")
                             ),
                         );
-                    } else if let Some(k) = sample.iter().position(|x| !x.is_finite()) {
+                    } else if let Some(k) = (0..COLUMNS.len()).find(|&k| !(COLUMN_RANGES[k].contains(&sample[k]))) {
+                        let r = &COLUMN_RANGES[k];
                         v.fail(
                             &format!("samples[{j}]"),
-                            format!("{} is {}: must be a finite number", COLUMNS[k], sample[k]),
+                            format!(
+                                "{} is {}: must be between {} and {}",
+                                COLUMNS[k],
+                                number(sample[k]),
+                                number(*r.start()),
+                                number(*r.end())
+                            ),
                         );
                     }
                 }

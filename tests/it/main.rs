@@ -16,3 +16,4 @@ mod rigid;
 mod steering;
 mod support;
 mod switching;
+mod ticks;
