@@ -6,6 +6,7 @@ mod cli;
 mod court;
 mod determinism;
 mod experiments;
+mod fuzz;
 mod gait;
 #[cfg(feature = "game")]
 mod game;
