@@ -40,9 +40,11 @@ fn level_name<S: serde::Serializer>(level: &Lod, s: S) -> Result<S::Ok, S::Error
 }
 
 /// The scenario with `count` creatures of the same mix, in a court grown to the same density.
+/// A scenario of no creatures at all has no density: its first group gets them all, in the
+/// court as if the scenario had one.
 pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig {
     let mut c = config.clone();
-    let base = config.scenario.creature_count();
+    let base = config.scenario.creature_count().max(1);
     let mut left = count;
     for (i, g) in c.scenario.creatures.iter_mut().enumerate().rev() {
         g.count = if i == 0 {
@@ -155,9 +157,10 @@ fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
     let kinds = KindTable::of(config);
     let mut c = config.clone();
     c.scenario.creatures.retain(|g| {
-        config
-            .kind_index(&g.kind)
-            .is_some_and(|kind| kinds[kind].levels.contains(&level))
+        g.count > 0
+            && config
+                .kind_index(&g.kind)
+                .is_some_and(|kind| kinds[kind].levels.contains(&level))
     });
     c
 }
@@ -188,6 +191,12 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
         };
         let level_config = kinds_with(config, level);
         if level_config.scenario.creatures.is_empty() {
+            if !json {
+                println!(
+                    "{:<11} skipped: no creature of the scenario has a model at this level",
+                    level.name()
+                );
+            }
             continue;
         }
         let b = bench_level(&level_config, level, policy, &effort);

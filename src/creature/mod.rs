@@ -391,3 +391,27 @@ pub(super) fn plugin(app: &mut App) {
     app.add_systems(SimStart, spawn_creatures.after(crate::arena::spawn_arena));
     steering::plugin(app);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use std::cell::Cell;
+
+    #[test]
+    fn a_full_court_gives_a_spot_after_a_bounded_number_of_tries() {
+        let mut rng = WorldRng(rand::rngs::StdRng::seed_from_u64(1));
+        let asked = Cell::new(0);
+        let half = Vec2::new(3.0, 2.0);
+        // Nowhere is clear enough: the clearest of the tries is taken.
+        let spot = find_free_spot(&mut rng, half, 0.5, 1.0, |p| {
+            asked.set(asked.get() + 1);
+            -p.length()
+        });
+        assert_eq!(asked.get(), PLACEMENT_ATTEMPTS);
+        assert!(spot.x.abs() <= 2.5 && spot.y.abs() <= 1.5, "{spot}");
+        // A margin wider than the court leaves only its centre line, still without a loop.
+        let spot = find_free_spot(&mut rng, half, 10.0, 1.0, |_| 0.0);
+        assert_eq!(spot, Vec2::ZERO);
+    }
+}

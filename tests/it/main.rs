@@ -6,6 +6,7 @@ mod cli;
 mod court;
 mod determinism;
 mod experiments;
+mod fuzz;
 mod gait;
 #[cfg(feature = "game")]
 mod game;
@@ -19,3 +20,4 @@ mod schedule;
 mod steering;
 mod support;
 mod switching;
+mod ticks;
