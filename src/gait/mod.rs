@@ -175,8 +175,8 @@ impl GaitPose {
             pitch_rad: self.pitch_rad + (other.pitch_rad - self.pitch_rad) * t,
             ..self
         };
-        for (leg, o) in pose.legs.iter_mut().zip(other.legs) {
-            *leg = leg.lerp(o, t);
+        for (leg, o) in pose.legs_mut().iter_mut().zip(other.legs()) {
+            *leg = leg.lerp(*o, t);
         }
         pose
     }
