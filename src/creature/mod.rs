@@ -363,7 +363,8 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
-        let level = config.scenario.level_policy.initial_level(&kinds[kind].levels);
+        // As point masses: each enters its level once all are placed (`lod::select`).
+        let level = Lod::PointMass;
         for _ in 0..group.count {
             // The puck starts at the centre.
             let spot = find_free_spot(&mut rng, half, radius + clear, radius + clear, |p| {

@@ -265,9 +265,10 @@ fn select_levels(
     settled.0 = !policy.is_dynamic() && creatures.iter().all(|(_, lod, _, choice)| *lod == choice.wanted);
 }
 
-/// A new world's creatures start at the level the policy's rules give them where they stand,
-/// in the rhythm and pose of that level, not at a default level they would leave in their
-/// first flight window (so a puck area covering the court is the all-rigid game).
+/// A new world's creatures, placed as point masses, start at the level the policy gives them
+/// where they stand, in the rhythm and pose of that level, not at a default level they would
+/// leave in their first flight window. Every policy's levels are entered here, in one order,
+/// so that a puck area covering the court is the all-rigid game bit for bit.
 fn start_at_selected_levels(
     mut commands: Commands,
     clock: Res<SimClock>,
@@ -288,14 +289,15 @@ fn start_at_selected_levels(
     )>,
 ) {
     let policy = config.scenario.level_policy;
-    if !policy.is_dynamic() {
-        return;
-    }
     let inputs = LevelInputs::new(&config.rules, &kinds, &puck, &court, &grid, &camera);
     let enter = Radii::of(&config.rules, camera.half_view_rad, false);
     for (entity, c, &lod, s, mut gait, mut pose, mut choice) in &mut creatures {
         let kind = &kinds[c.kind];
-        let level = kind.best_level(inputs.level(policy, c, s, &enter));
+        let level = if policy.is_dynamic() {
+            kind.best_level(inputs.level(policy, c, s, &enter))
+        } else {
+            policy.initial_level(&kind.levels)
+        };
         if level != lod {
             (*gait, *pose) = starting_gait(level, kind, gait.cycle, clock.seconds() as f32);
             // Its new level's model is built as it enters it (the level's observers).

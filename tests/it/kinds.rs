@@ -191,4 +191,4 @@ fn the_pinned_scene_gives_the_same_digest_as_when_it_was_pinned() {
     assert_eq!(sim.state_digest(), PINNED_DIGEST, "{summary:?}");
 }
 
-const PINNED_DIGEST: u64 = 110968322212846783;
+const PINNED_DIGEST: u64 = 14698065385395456291;
