@@ -312,7 +312,7 @@ fn absurd_sizes_masses_speeds_and_rates_are_refused_with_the_unit() {
         ),
         (
             "gaits/hopper.ron",
-            "[0.7899582,",
+            "[0.7899571,",
             "[1e30,",
             "rows[0].samples[0]",
             "body_height_m is 1e30",
@@ -494,7 +494,7 @@ fn values_of_the_wrong_type_are_named_by_their_whole_path() {
             "flight_window: (\"a\"",
             "flight_window[0]",
         ),
-        ("gaits/hopper.ron", "[0.7899582,", "[\"x\",", "rows[0].samples[0][0]"),
+        ("gaits/hopper.ron", "[0.7899571,", "[\"x\",", "rows[0].samples[0][0]"),
     ] {
         let err = load_error("wrong_types", file, &edited(file, from, to));
         assert_names(&err, file, field, "line");
