@@ -1,16 +1,7 @@
 //! Same seed, same files, same result, bit for bit.
 
 use crate::support::*;
-use simlod::headless::HeadlessSim;
 use simlod::lod::Lod;
-
-fn digest_after(config: simlod::config::SimConfig, seconds: f64) -> (u64, simlod::outcome::Summary) {
-    let mut sim = HeadlessSim::new(config);
-    sim.run_for(seconds);
-    let mut summary = sim.summary(0.0);
-    summary.realtime_factor = 0.0;
-    (sim.state_digest(), summary)
-}
 
 #[test]
 fn two_runs_with_one_seed_end_in_identical_states() {

@@ -8,10 +8,8 @@ use crate::support::*;
 use simlod::config::SimConfig;
 use simlod::creature::DesiredVelocity;
 use simlod::experiments::lone_creature;
-use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::Shove;
-use simlod::outcome::Summary;
 
 /// A game of the shipped kinds under the combined policy, blended as the shipped rules say or
 /// not at all.
@@ -21,14 +19,6 @@ fn game(blended: bool) -> SimConfig {
         config.rules.blend_s = 0.0;
     }
     config
-}
-
-fn run(config: SimConfig, seconds: f64) -> (u64, Summary) {
-    let mut sim = HeadlessSim::new(config);
-    sim.run_for(seconds);
-    let mut summary = sim.summary(0.0);
-    summary.realtime_factor = 0.0;
-    (sim.state_digest(), summary)
 }
 
 #[test]
@@ -48,7 +38,7 @@ fn over_whole_games_the_blend_keeps_nearly_every_switch_under_the_bars() {
     let mut pops = Vec::new();
     let (mut switches, mut falls) = (0, 0);
     for config in [game(true), camera, collisions_only] {
-        let (_, summary) = run(config, 20.0);
+        let (_, summary) = digest_after(config, 20.0);
         switches += summary.switches.total();
         falls += summary.falls;
         pops.extend(summary.pops);
@@ -100,8 +90,8 @@ fn over_whole_games_the_blend_keeps_nearly_every_switch_under_the_bars() {
 
 #[test]
 fn blending_changes_what_is_drawn_never_the_outcome() {
-    let (blended, mut a) = run(game(true), 15.0);
-    let (unblended, mut b) = run(game(false), 15.0);
+    let (blended, mut a) = digest_after(game(true), 15.0);
+    let (unblended, mut b) = digest_after(game(false), 15.0);
     assert_eq!(blended, unblended, "the simulated state, bit for bit");
     assert!(a.switches.total() > 10);
     // Only the pops as drawn differ.

@@ -60,3 +60,12 @@ pub fn scene(groups: &[(&str, u32)], policy: simlod::lod::LevelPolicy) -> SimCon
     config.scenario.level_policy = policy;
     config
 }
+
+/// The state digest and summary (wall time aside) after `seconds` of `config`.
+pub fn digest_after(config: SimConfig, seconds: f64) -> (u64, simlod::outcome::Summary) {
+    let mut sim = HeadlessSim::new(config);
+    sim.run_for(seconds);
+    let mut summary = sim.summary(0.0);
+    summary.realtime_factor = 0.0;
+    (sim.state_digest(), summary)
+}
