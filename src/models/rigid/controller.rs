@@ -27,6 +27,8 @@ use crate::outcome::FallQueue;
 
 /// Foot centre this far above its resting height still counts as on the ground.
 pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
+/// With legs in turn, a stance this many times its expected length has stalled.
+const STALLED_STANCE_SHARE: f32 = 3.0;
 /// Share of a leg's twist about its own axis (relative to the body) removed each tick. The
 /// leg is thin, so its twist inertia is tiny: the damping is scaled to it, or it would
 /// overshoot and blow up.
@@ -241,7 +243,11 @@ impl Raibert {
             StancePhase::Flight => {
                 // The leg due to land first; any other that meets the ground instead takes over.
                 let landing = self.landing_leg(legs, together);
-                let Some(touched) = (0..legs).map(|k| (landing + k) % legs).find(|&i| on_ground(i)) else {
+                // With legs in turn, not the one that just lifted off (it is retracting).
+                let Some(touched) = (0..legs)
+                    .map(|k| (landing + k) % legs)
+                    .find(|&i| on_ground(i) && (together || i != self.stance_leg))
+                else {
                     return;
                 };
                 let flight = now - self.last_liftoff_s;
@@ -264,7 +270,10 @@ impl Raibert {
                 self.phase = StancePhase::Thrust;
             }
             StancePhase::Compression | StancePhase::Thrust
-                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i)) =>
+                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i))
+                    // With legs in turn, a stance that stalled (the leg at its thrust length
+                    // without lifting off) ends: the leg retracts and the next one lands.
+                    || (!together && now - self.last_touchdown_s > STALLED_STANCE_SHARE * self.stance_s) =>
             {
                 self.stance_s = 0.5 * self.stance_s + 0.5 * (now - self.last_touchdown_s).clamp(0.05, 0.5);
                 self.last_liftoff_s = now;
