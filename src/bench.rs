@@ -40,9 +40,11 @@ fn level_name<S: serde::Serializer>(level: &Lod, s: S) -> Result<S::Ok, S::Error
 }
 
 /// The scenario with `count` creatures of the same mix, in a court grown to the same density.
+/// A scenario of no creatures at all has no density: its first group gets them all, in the
+/// court as if the scenario had one.
 pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig {
     let mut c = config.clone();
-    let base = config.scenario.creature_count();
+    let base = config.scenario.creature_count().max(1);
     let mut left = count;
     for (i, g) in c.scenario.creatures.iter_mut().enumerate().rev() {
         g.count = if i == 0 {
@@ -60,14 +62,18 @@ pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig 
     c
 }
 
-fn median(mut values: Vec<f64>) -> f64 {
+pub fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]
 }
 
 /// Median frame time in seconds of `config`, after a warm-up.
 pub fn median_frame_seconds(config: SimConfig, warmup: usize, frames: usize) -> f64 {
-    let mut sim = HeadlessSim::new(config);
+    median_frame_seconds_of(&mut HeadlessSim::new(config), warmup, frames)
+}
+
+/// Median frame time in seconds of a world already built, after a warm-up.
+pub fn median_frame_seconds_of(sim: &mut HeadlessSim, warmup: usize, frames: usize) -> f64 {
     for _ in 0..warmup {
         sim.advance_frame();
     }
@@ -112,21 +118,9 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
         effort.warmup,
         effort.frames,
     );
-    let fits =
-        |n: u32| median_frame_seconds(scaled(config, n, policy), effort.warmup / 2, effort.frames) <= FRAME_BUDGET_S;
-    // Double until a count misses the budget, then halve the gap.
-    let (mut good, mut bad) = (0u32, effort.search_from);
-    while bad < crate::config::MAX_CREATURES && fits(bad) {
-        good = bad;
-        bad = (bad * 2).min(crate::config::MAX_CREATURES);
-    }
-    for _ in 0..effort.search_steps {
-        if bad - good <= good / 32 + 1 {
-            break;
-        }
-        let mid = good + (bad - good) / 2;
-        if fits(mid) { good = mid } else { bad = mid }
-    }
+    let good = most_within_budget(effort.search_from, effort.search_steps, |n| {
+        median_frame_seconds(scaled(config, n, policy), effort.warmup / 2, effort.frames)
+    });
     LevelBench {
         level,
         us_per_creature_per_frame: frame_s * 1e6 / f64::from(effort.reference),
@@ -138,14 +132,35 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
     }
 }
 
+/// The most creatures whose frame, `frame_s(n)` seconds, fits in 1/30 s: doubles from
+/// `search_from` until a count misses the budget, then halves the gap (at most `steps` times,
+/// to within 3 %).
+pub fn most_within_budget(search_from: u32, steps: u32, mut frame_s: impl FnMut(u32) -> f64) -> u32 {
+    let mut fits = |n: u32| frame_s(n) <= FRAME_BUDGET_S;
+    let (mut good, mut bad) = (0u32, search_from.max(1));
+    while bad < crate::config::MAX_CREATURES && fits(bad) {
+        good = bad;
+        bad = (bad * 2).min(crate::config::MAX_CREATURES);
+    }
+    for _ in 0..steps {
+        if bad - good <= good / 32 + 1 {
+            break;
+        }
+        let mid = good + (bad - good) / 2;
+        if fits(mid) { good = mid } else { bad = mid }
+    }
+    good
+}
+
 /// The scenario with only the kinds that have a model at `level`.
 fn kinds_with(config: &SimConfig, level: Lod) -> SimConfig {
     let kinds = KindTable::of(config);
     let mut c = config.clone();
     c.scenario.creatures.retain(|g| {
-        config
-            .kind_index(&g.kind)
-            .is_some_and(|kind| kinds[kind].levels.contains(&level))
+        g.count > 0
+            && config
+                .kind_index(&g.kind)
+                .is_some_and(|kind| kinds[kind].levels.contains(&level))
     });
     c
 }
@@ -176,6 +191,12 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
         };
         let level_config = kinds_with(config, level);
         if level_config.scenario.creatures.is_empty() {
+            if !json {
+                println!(
+                    "{:<11} skipped: no creature of the scenario has a model at this level",
+                    level.name()
+                );
+            }
             continue;
         }
         let b = bench_level(&level_config, level, policy, &effort);

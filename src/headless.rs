@@ -28,8 +28,7 @@ impl HeadlessSim {
         app.add_plugins(MinimalPlugins.set(TaskPoolPlugin {
             task_pool_options: compute_on_every_core(),
         }))
-        .add_plugins(SimPlugin { config })
-        .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
+        .add_plugins(SimPlugin { config });
         app.finish();
         app.cleanup();
         // Headless, every schedule is small: one thread runs them without wake-ups. Loops over
@@ -40,7 +39,7 @@ impl HeadlessSim {
         // The first update runs Startup and sets the clocks going without a fixed tick.
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(0));
         app.update();
-        app.insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_update));
+        run_ticks_per_update(app.world_mut(), ticks_per_update);
         Self { app, ticks_per_update }
     }
 
@@ -95,6 +94,20 @@ impl HeadlessSim {
             .hash(&mut h);
         h.finish()
     }
+}
+
+/// Makes every `App::update` run exactly `ticks` fixed ticks (of the world's `Time<Fixed>`).
+/// Bevy's virtual clock lets at most `max_delta` (250 ms by default) through one update and
+/// silently drops the rest, so a frame longer than that (8 ticks at 30 Hz decisions is 33 ms;
+/// 2000 ticks at 1 Hz is a whole second) would run fewer ticks than asked: the cap is raised
+/// to the frame.
+pub fn run_ticks_per_update(world: &mut World, ticks: u32) {
+    let frame = world.resource::<Time<Fixed>>().timestep() * ticks;
+    let mut clock = world.resource_mut::<Time<Virtual>>();
+    if frame > clock.max_delta() {
+        clock.set_max_delta(frame);
+    }
+    world.insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks));
 }
 
 /// Bevy's default gives compute a share of the cores, which on two cores is one thread, and

@@ -141,16 +141,86 @@ struct ExperimentArgs {
 #[derive(Subcommand)]
 enum ExperimentKind {
     /// Figures 3 and 4: velocity and ground path under step changes in desired velocity.
-    StepResponse {
-        #[command(flatten)]
-        scenario: ScenarioArgs,
-        /// The experiment's file.
-        #[arg(long, default_value = "assets/experiments/step_response.ron")]
-        experiment: PathBuf,
-        /// Folder the CSV files are written to.
+    StepResponse(ExperimentRun),
+    /// Table 1: cost per creature per 1/30 s at each level (the model alone, and in a game).
+    Table1(ExperimentRun),
+    /// Figure 7: creatures at 30 fps against the percentage of rigid ones.
+    Fig7(ExperimentRun),
+    /// Figure 8: average and lowest frame rate against the puck's radius of influence.
+    Fig8(ExperimentRun),
+    /// Figure 9: average and lowest frame rate against the camera's radius of influence.
+    Fig9(ExperimentRun),
+    /// Figure 10: the change in creatures that hit the puck or a wall, against all rigid.
+    Fig10(ExperimentRun),
+    /// Every experiment, into one folder.
+    All(ExperimentRun),
+    /// Combine fig10 shards (`--shard K/N` runs) into the files of one unsharded run.
+    Merge {
+        /// The shards' output folders.
+        #[arg(required = true)]
+        dirs: Vec<PathBuf>,
+        /// Folder the merged files are written to.
         #[arg(long)]
         out: PathBuf,
     },
+}
+
+#[derive(Args)]
+struct ExperimentRun {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
+    /// The experiment's file (default: experiments/<name>.ron under the assets folder).
+    #[arg(long)]
+    experiment: Option<PathBuf>,
+    /// Folder the CSV, PNG, JSON and report.md files are written to.
+    #[arg(long)]
+    out: PathBuf,
+    /// The experiment file's `quick` settings: small counts, seconds of work.
+    #[arg(long)]
+    quick: bool,
+    /// Overrides the experiment file's trial count.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    trials: Option<u32>,
+    /// Threads for independent trials (default: every core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    jobs: Option<u32>,
+    /// Run only the K-th of N disjoint parts of the trials (fig10), e.g. 2/4.
+    #[arg(long)]
+    shard: Option<experiments::Shard>,
+}
+
+impl ExperimentRun {
+    fn run(&self, name: &str) -> Result<(), String> {
+        let config = self.scenario.load()?;
+        let options = experiments::Options {
+            out: self.out.clone(),
+            quick: self.quick,
+            trials: self.trials,
+            jobs: self.jobs.map_or_else(
+                || std::thread::available_parallelism().map_or(1, |n| n.get()),
+                |j| j as usize,
+            ),
+            shard: self.shard.unwrap_or(experiments::Shard::WHOLE),
+            assets: self.scenario.assets.clone(),
+            scenario: self.scenario.scenario.clone(),
+        };
+        let names: Vec<&str> = if name == "all" {
+            if self.experiment.is_some() {
+                return Err("--experiment names one experiment's file; `all` reads each from the assets folder".into());
+            }
+            experiments::ALL.to_vec()
+        } else {
+            vec![name]
+        };
+        for name in names {
+            let file = self
+                .experiment
+                .clone()
+                .unwrap_or_else(|| experiments::default_file(&self.scenario.assets, name));
+            print!("{}", experiments::run_named(name, &config, &file, &options)?);
+        }
+        Ok(())
+    }
 }
 
 #[derive(Args)]
@@ -173,6 +243,9 @@ struct ScenarioArgs {
     /// Overrides the camera's radius of influence (metres).
     #[arg(long, value_parser = non_negative_metres)]
     camera_radius: Option<f32>,
+    /// Overrides the scenario's level rules file.
+    #[arg(long)]
+    rules: Option<PathBuf>,
 }
 
 fn non_negative_metres(s: &str) -> Result<f32, String> {
@@ -194,6 +267,9 @@ impl ScenarioArgs {
     fn load_without_table_of(&self, without: Option<&str>) -> Result<SimConfig, String> {
         let mut config =
             SimConfig::load_without_table_of(&self.scenario, &self.assets, without).map_err(|e| e.to_string())?;
+        if let Some(rules) = &self.rules {
+            config.rules = load_file(rules).map_err(|e| e.to_string())?;
+        }
         if let Some(seed) = self.seed {
             config.scenario.seed = seed;
         }
@@ -304,7 +380,10 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         "creatures that collided with the puck or a wall: {}",
         s.creatures_collided
     );
-    println!("falls: {}, respawns: {}", s.falls, s.respawns);
+    println!(
+        "falls: {} ({} within a step of going rigid), respawns: {}",
+        s.falls, s.falls_after_switch, s.respawns
+    );
     println!("creatures per level at the end: {}", join(&s.levels));
     let mean: Vec<String> = s
         .levels_mean
@@ -319,6 +398,20 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         .chain([format!("total {}", s.switches.total())])
         .collect();
     println!("level switches: {}", switches.join(", "));
+    for p in &s.pops {
+        println!(
+            "  pops {}->{}{}: as drawn {:.2} cm, {:.2} deg, {:.3} m/s; models alone {:.1} cm, {:.1} deg (largest of {})",
+            p.from,
+            p.to,
+            if p.forced { " (forced)" } else { "" },
+            p.metres.max * 100.0,
+            p.degrees.max,
+            p.velocity_m_per_s.max,
+            p.model_metres.max * 100.0,
+            p.model_degrees.max,
+            p.count
+        );
+    }
 }
 
 fn main() -> ExitCode {
@@ -347,17 +440,18 @@ fn main() -> ExitCode {
             .scenario
             .load()
             .map(|config| bench::run(&config, args.quick, args.json, args.level)),
-        Some(Command::Experiment(ExperimentArgs {
-            which:
-                ExperimentKind::StepResponse {
-                    scenario,
-                    experiment,
-                    out,
-                },
-        })) => scenario
-            .load()
-            .and_then(|config| experiments::step_response::run(&config, &experiment, &out))
-            .map(|summary| print!("{summary}")),
+        Some(Command::Experiment(ExperimentArgs { which })) => match which {
+            ExperimentKind::StepResponse(run) => run.run("step-response"),
+            ExperimentKind::Table1(run) => run.run("table1"),
+            ExperimentKind::Fig7(run) => run.run("fig7"),
+            ExperimentKind::Fig8(run) => run.run("fig8"),
+            ExperimentKind::Fig9(run) => run.run("fig9"),
+            ExperimentKind::Fig10(run) => run.run("fig10"),
+            ExperimentKind::All(run) => run.run("all"),
+            ExperimentKind::Merge { dirs, out } => {
+                experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))
+            }
+        },
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,7 +7,8 @@ use serde::{Deserialize, Serialize};
 /// The most legs a kind may have (the pose keeps them in a fixed array: no allocation per tick).
 pub const MAX_LEGS: usize = 4;
 
-/// One kind of legged creature (the one-legged hopper, the biped, or a modder's own).
+/// One kind of legged creature (the one-legged hopper, the biped, or a modder's own). Each
+/// number's comment gives the range it is checked against when loaded.
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreatureDef {
@@ -15,21 +16,24 @@ pub struct CreatureDef {
     pub name: String,
     pub body: BodyConfig,
     /// Planar speed limit. A kind with a gait table moves its point mass (hybrid and point-mass
-    /// levels) at the table's measured limits instead (paper 3.2).
+    /// levels) at the table's measured limits instead (paper 3.2). 0.01 to 50 m/s.
     pub top_speed_m_per_s: f32,
     /// How fast the creature may change its velocity: the rigid model's command follows the
     /// desired velocity at this rate; the point mass uses it when there is no gait table.
+    /// 0.01 to 1000 m/s^2.
     pub acceleration_limit_m_per_s2: f32,
-    /// How fast the point mass turns its body to face its direction of travel.
+    /// How fast the point mass turns its body to face its direction of travel; 1 to 36,000
+    /// degrees/s.
     pub turn_rate_deg_per_s: f32,
-    /// Touchdown to touchdown.
+    /// Touchdown to touchdown; 0.05 to 10 s.
     pub hop_period_s: f32,
-    /// Part of the hop cycle spent in the air, after stance (0..1).
+    /// Part of the hop cycle spent in the air, after stance; 0.05 to 0.95.
     pub flight_fraction: f32,
     /// At the point-mass level there is no balance to lose: a creature falls when an impact's
-    /// normal speed exceeds this.
+    /// normal speed exceeds this. 0.01 to 1000 m/s.
     pub fall_impact_speed_m_per_s: f32,
-    /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop).
+    /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop); 0
+    /// to 1.
     pub collision_restitution: f32,
     pub steering: SteeringConfig,
     /// The legs (at least one, at most [`MAX_LEGS`]): drawn at every level, simulated at the
@@ -40,7 +44,7 @@ pub struct CreatureDef {
     /// The rigid-body model (paper 3.1); a kind without one is never simulated rigid.
     #[serde(default)]
     pub rigid: Option<RigidConfig>,
-    /// The gait table file (relative to the assets folder) the hybrid level plays back
+    /// The gait table file (relative to the assets folder and inside it) the hybrid level plays back
     /// (paper 3.2), written by `simlod record-gait`; a kind without one is never hybrid.
     #[serde(default)]
     pub gait_table: Option<String>,
@@ -51,21 +55,29 @@ pub struct CreatureDef {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LegConfig {
-    /// Where the hip sits, from the body's centre: x forward, y up, z to the right.
+    /// Where the hip sits, from the body's centre: x forward, y up, z to the right; -5 to 5 m.
     pub hip_m: (f32, f32, f32),
+    /// 0.02 to 5 m.
     pub upper_length_m: f32,
+    /// 0.01 to 1000 kg.
     pub upper_mass_kg: f32,
-    /// Foot included.
+    /// Foot included; 0.02 to 5 m.
     pub lower_length_m: f32,
+    /// 0.01 to 1000 kg.
     pub lower_mass_kg: f32,
+    /// 0.002 to 0.5 m.
     pub radius_m: f32,
+    /// 0.005 to 0.5 m.
     pub foot_radius_m: f32,
+    /// 0 to 10.
     pub foot_friction: f32,
-    /// Hip to foot centre with the spring at rest.
+    /// Hip to foot centre with the spring at rest; 0.05 to 10 m.
     pub rest_length_m: f32,
-    /// Hip to foot centre at the joint's stop.
+    /// Hip to foot centre at the joint's stop; 0.02 to 10 m, below the rest length.
     pub min_length_m: f32,
+    /// 1 to 1e6 N/m.
     pub spring_n_per_m: f32,
+    /// 0 to 1e5 N s/m.
     pub damping_n_s_per_m: f32,
 }
 
@@ -94,8 +106,11 @@ impl Stance {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigidConfig {
-    /// Half extents of the body box: x forward, y up, z to the side. Its mass is `body.mass_kg`.
+    /// Half extents of the body box: x forward, y up, z to the side; each 0.01 to 5 m. Its mass
+    /// is `body.mass_kg`.
     pub body_half_extents_m: (f32, f32, f32),
+    /// Gains and limits: times 0.01 to 5 s, thrusts 0 to 1 m, gains `*_kp_*` 0 to 1e5 and
+    /// `*_kd_*` 0 to 1e4, torques 0 to 1e4 N m, speeds 0 to 50 m/s, as each field says.
     pub controller: RaibertConfig,
     pub fall: FallConfig,
 }
@@ -144,72 +159,77 @@ pub struct RaibertConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FallConfig {
-    /// The body's centre below this height.
+    /// The body's centre below this height; 0.01 to 10 m.
     pub body_min_height_m: f32,
     /// The body's up axis tilted further than this from vertical.
     pub max_tilt_deg: f32,
-    /// Any part faster than this is a numerical blow-up, not motion: handled as a fall.
+    /// Any part faster than this is a numerical blow-up, not motion: handled as a fall; 1 to
+    /// 1000 m/s.
     pub blow_up_speed_m_per_s: f32,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyConfig {
-    /// Radius of the creature's footprint on the ground: its collision circle.
+    /// Radius of the creature's footprint on the ground: its collision circle; 0.01 to 10 m.
     pub radius_m: f32,
-    /// Height of the hip above the ground while standing.
+    /// Height of the hip above the ground while standing; 0.01 to 20 m.
     pub hip_height_m: f32,
+    /// 0.01 to 10,000 kg.
     pub mass_kg: f32,
 }
 
 /// How the creature picks its desired velocity (paper 3: escape the puck, avoid walls and
-/// other creatures). Weights are relative; the sum is scaled to the top speed.
+/// other creatures). Weights are relative (0 to 1000); the sum is scaled to the top speed.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SteeringConfig {
-    /// Speed of undisturbed wandering.
+    /// Speed of undisturbed wandering; 0 to the top speed.
     pub cruise_speed_m_per_s: f32,
-    /// Largest rate at which the wandering heading drifts.
+    /// Largest rate at which the wandering heading drifts; 0 to 100 rad/s.
     pub wander_turn_rad_per_s: f32,
-    /// The creature flees when this close to the puck's path over the look-ahead.
+    /// The creature flees when this close to the puck's path over the look-ahead; 0 to 10,000 m.
     pub puck_alert_distance_m: f32,
-    /// How far ahead the puck's path is predicted.
+    /// How far ahead the puck's path is predicted; 0 to 60 s.
     pub puck_lookahead_s: f32,
     pub puck_weight: f32,
-    /// Walls repel within this distance.
+    /// Walls repel within this distance; 0 to 10,000 m.
     pub wall_avoid_distance_m: f32,
     pub wall_weight: f32,
-    /// Other creatures repel within this distance (centre to centre).
+    /// Other creatures repel within this distance (centre to centre); 0 to 100 m: the
+    /// neighbour grid's cells are this big.
     pub separation_distance_m: f32,
     pub separation_weight: f32,
 }
 
 impl Validate for CreatureDef {
     fn validate(&self, v: &mut Validator) {
-        v.require(
-            !self.name.is_empty()
-                && self
-                    .name
-                    .chars()
-                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-'),
-            "name",
-            format!(
-                "must be a non-empty name of letters, digits, '-' or '_', got {:?}",
-                self.name
-            ),
-        );
+        v.kind_name("name", &self.name);
         v.nested("body", |v| {
-            v.positive("radius_m", self.body.radius_m);
-            v.positive("hip_height_m", self.body.hip_height_m);
-            v.positive("mass_kg", self.body.mass_kg);
+            v.range("radius_m", self.body.radius_m, 0.01, 10.0);
+            v.range("hip_height_m", self.body.hip_height_m, 0.01, 20.0);
+            v.range("mass_kg", self.body.mass_kg, 0.01, 10_000.0);
         });
-        v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
-        v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
-        v.positive("turn_rate_deg_per_s", self.turn_rate_deg_per_s);
-        v.positive("hop_period_s", self.hop_period_s);
-        v.within("flight_fraction", self.flight_fraction, 0.05, 0.95);
-        v.positive("fall_impact_speed_m_per_s", self.fall_impact_speed_m_per_s);
-        v.within("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        v.range("top_speed_m_per_s", self.top_speed_m_per_s, 0.01, 50.0);
+        v.range(
+            "acceleration_limit_m_per_s2",
+            self.acceleration_limit_m_per_s2,
+            0.01,
+            1000.0,
+        );
+        v.range("turn_rate_deg_per_s", self.turn_rate_deg_per_s, 1.0, 36_000.0);
+        v.range("hop_period_s", self.hop_period_s, 0.05, 10.0);
+        v.range("flight_fraction", self.flight_fraction, 0.05, 0.95);
+        v.range(
+            "fall_impact_speed_m_per_s",
+            self.fall_impact_speed_m_per_s,
+            0.01,
+            1000.0,
+        );
+        v.range("collision_restitution", self.collision_restitution, 0.0, 1.0);
+        if let Some(file) = &self.gait_table {
+            v.asset_path("gait_table", file);
+        }
         v.require(
             (1..=MAX_LEGS).contains(&self.legs.len()),
             "legs",
@@ -223,15 +243,15 @@ impl Validate for CreatureDef {
         }
         let s = &self.steering;
         v.nested("steering", |v| {
-            v.non_negative("cruise_speed_m_per_s", s.cruise_speed_m_per_s);
-            v.non_negative("wander_turn_rad_per_s", s.wander_turn_rad_per_s);
-            v.non_negative("puck_alert_distance_m", s.puck_alert_distance_m);
-            v.non_negative("puck_lookahead_s", s.puck_lookahead_s);
-            v.non_negative("puck_weight", s.puck_weight);
-            v.non_negative("wall_avoid_distance_m", s.wall_avoid_distance_m);
-            v.non_negative("wall_weight", s.wall_weight);
-            v.non_negative("separation_distance_m", s.separation_distance_m);
-            v.non_negative("separation_weight", s.separation_weight);
+            v.range("cruise_speed_m_per_s", s.cruise_speed_m_per_s, 0.0, 50.0);
+            v.range("wander_turn_rad_per_s", s.wander_turn_rad_per_s, 0.0, 100.0);
+            v.range("puck_alert_distance_m", s.puck_alert_distance_m, 0.0, 10_000.0);
+            v.range("puck_lookahead_s", s.puck_lookahead_s, 0.0, 60.0);
+            v.range("puck_weight", s.puck_weight, 0.0, 1000.0);
+            v.range("wall_avoid_distance_m", s.wall_avoid_distance_m, 0.0, 10_000.0);
+            v.range("wall_weight", s.wall_weight, 0.0, 1000.0);
+            v.range("separation_distance_m", s.separation_distance_m, 0.0, 100.0);
+            v.range("separation_weight", s.separation_weight, 0.0, 1000.0);
             v.require(
                 s.cruise_speed_m_per_s.is_nan() || s.cruise_speed_m_per_s <= self.top_speed_m_per_s,
                 "cruise_speed_m_per_s",
@@ -245,19 +265,19 @@ impl Validate for LegConfig {
     fn validate(&self, v: &mut Validator) {
         let (x, y, z) = self.hip_m;
         for (i, e) in [x, y, z].into_iter().enumerate() {
-            v.within(&format!("hip_m.{i}"), e, -5.0, 5.0);
+            v.range(&format!("hip_m.{i}"), e, -5.0, 5.0);
         }
-        v.positive("upper_length_m", self.upper_length_m);
-        v.positive("upper_mass_kg", self.upper_mass_kg);
-        v.positive("lower_length_m", self.lower_length_m);
-        v.positive("lower_mass_kg", self.lower_mass_kg);
-        v.positive("radius_m", self.radius_m);
-        v.positive("foot_radius_m", self.foot_radius_m);
-        v.non_negative("foot_friction", self.foot_friction);
-        v.positive("rest_length_m", self.rest_length_m);
-        v.positive("min_length_m", self.min_length_m);
-        v.positive("spring_n_per_m", self.spring_n_per_m);
-        v.non_negative("damping_n_s_per_m", self.damping_n_s_per_m);
+        v.range("upper_length_m", self.upper_length_m, 0.02, 5.0);
+        v.range("upper_mass_kg", self.upper_mass_kg, 0.01, 1000.0);
+        v.range("lower_length_m", self.lower_length_m, 0.02, 5.0);
+        v.range("lower_mass_kg", self.lower_mass_kg, 0.01, 1000.0);
+        v.range("radius_m", self.radius_m, 0.002, 0.5);
+        v.range("foot_radius_m", self.foot_radius_m, 0.005, 0.5);
+        v.range("foot_friction", self.foot_friction, 0.0, 10.0);
+        v.range("rest_length_m", self.rest_length_m, 0.05, 10.0);
+        v.range("min_length_m", self.min_length_m, 0.02, 10.0);
+        v.range("spring_n_per_m", self.spring_n_per_m, 1.0, 1e6);
+        v.range("damping_n_s_per_m", self.damping_n_s_per_m, 0.0, 1e5);
         v.require(
             self.min_length_m < self.rest_length_m,
             "min_length_m",
@@ -275,7 +295,7 @@ impl RigidConfig {
     fn validate_on(&self, legs: &[LegConfig], v: &mut Validator) {
         let (x, y, z) = self.body_half_extents_m;
         for (i, e) in [x, y, z].into_iter().enumerate() {
-            v.positive(&format!("body_half_extents_m.{i}"), e);
+            v.range(&format!("body_half_extents_m.{i}"), e, 0.01, 5.0);
         }
         for (i, leg) in legs.iter().enumerate() {
             v.require(
@@ -289,26 +309,26 @@ impl RigidConfig {
         }
         let c = &self.controller;
         v.nested("controller", |v| {
-            v.positive("flight_time_s", c.flight_time_s);
-            v.non_negative("thrust_initial_m", c.thrust_initial_m);
-            v.non_negative("thrust_max_m", c.thrust_max_m);
-            v.non_negative("thrust_gain_m_per_s", c.thrust_gain_m_per_s);
-            v.non_negative("speed_gain_s", c.speed_gain_s);
+            v.range("flight_time_s", c.flight_time_s, 0.01, 5.0);
+            v.range("thrust_initial_m", c.thrust_initial_m, 0.0, 1.0);
+            v.range("thrust_max_m", c.thrust_max_m, 0.0, 1.0);
+            v.range("thrust_gain_m_per_s", c.thrust_gain_m_per_s, 0.0, 10.0);
+            v.range("speed_gain_s", c.speed_gain_s, 0.0, 1.0);
             v.within("speed_integral_gain", c.speed_integral_gain, 0.0, 1.0);
             v.within("max_foot_offset_fraction", c.max_foot_offset_fraction, 0.0, 0.9);
-            for (name, value) in [
-                ("swing_kp_nm_per_rad", c.swing_kp_nm_per_rad),
-                ("swing_kd_nm_s_per_rad", c.swing_kd_nm_s_per_rad),
-                ("attitude_kp_nm_per_rad", c.attitude_kp_nm_per_rad),
-                ("attitude_kd_nm_s_per_rad", c.attitude_kd_nm_s_per_rad),
-                ("yaw_kp_nm_per_rad", c.yaw_kp_nm_per_rad),
-                ("yaw_kd_nm_s_per_rad", c.yaw_kd_nm_s_per_rad),
-                ("yaw_max_torque_nm", c.yaw_max_torque_nm),
-                ("turn_min_speed_m_per_s", c.turn_min_speed_m_per_s),
-                ("max_speed_correction_m_per_s", c.max_speed_correction_m_per_s),
-                ("idle_leg_retract_m", c.idle_leg_retract_m),
+            for (name, value, most) in [
+                ("swing_kp_nm_per_rad", c.swing_kp_nm_per_rad, 1e5),
+                ("swing_kd_nm_s_per_rad", c.swing_kd_nm_s_per_rad, 1e4),
+                ("attitude_kp_nm_per_rad", c.attitude_kp_nm_per_rad, 1e5),
+                ("attitude_kd_nm_s_per_rad", c.attitude_kd_nm_s_per_rad, 1e4),
+                ("yaw_kp_nm_per_rad", c.yaw_kp_nm_per_rad, 1e5),
+                ("yaw_kd_nm_s_per_rad", c.yaw_kd_nm_s_per_rad, 1e4),
+                ("yaw_max_torque_nm", c.yaw_max_torque_nm, 1e4),
+                ("turn_min_speed_m_per_s", c.turn_min_speed_m_per_s, 50.0),
+                ("max_speed_correction_m_per_s", c.max_speed_correction_m_per_s, 50.0),
+                ("idle_leg_retract_m", c.idle_leg_retract_m, 5.0),
             ] {
-                v.non_negative(name, value);
+                v.range(name, value, 0.0, most);
             }
             v.within("max_yaw_error_rad", c.max_yaw_error_rad, 0.01, std::f32::consts::PI);
             v.require(
@@ -318,9 +338,9 @@ impl RigidConfig {
             );
         });
         v.nested("fall", |v| {
-            v.positive("body_min_height_m", self.fall.body_min_height_m);
+            v.range("body_min_height_m", self.fall.body_min_height_m, 0.01, 10.0);
             v.within("max_tilt_deg", self.fall.max_tilt_deg, 1.0, 180.0);
-            v.positive("blow_up_speed_m_per_s", self.fall.blow_up_speed_m_per_s);
+            v.range("blow_up_speed_m_per_s", self.fall.blow_up_speed_m_per_s, 1.0, 1000.0);
         });
     }
 }

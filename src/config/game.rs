@@ -30,15 +30,16 @@ pub struct GameConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraConfig {
-    /// How far behind the player the camera sits, away from the puck.
+    /// How far behind the player the camera sits, away from the puck; 0.1 to 1000 m.
     pub follow_distance_m: f32,
+    /// 0.1 to 1000 m.
     pub follow_height_m: f32,
     /// Where the camera aims: 0 at the player, 1 at the puck.
     pub aim_toward_puck_fraction: f32,
     /// Height of the point aimed at; below the ice (negative) tilts the view down, so the
     /// court fills more of it and the sky less.
     pub aim_height_m: f32,
-    /// How fast the camera catches up with where it wants to be (per second).
+    /// How fast the camera catches up with where it wants to be; 0.01 to 1000 per second.
     pub follow_rate_per_s: f32,
     pub field_of_view_deg: f32,
 }
@@ -51,9 +52,10 @@ pub struct InsetConfig {
     pub width_fraction: f32,
     /// Gap between the inset and the window's edges.
     pub margin_px: f32,
-    /// Ground shown around the court.
+    /// Ground shown around the court; 0 to 10,000 m.
     pub border_m: f32,
-    /// Creatures are tiny seen from above: each gets a dot this big, seen only from above.
+    /// Creatures are tiny seen from above: each gets a dot this big, seen only from above;
+    /// 0.01 to 100 m.
     pub creature_dot_radius_m: f32,
     /// The player's view, drawn from above as a fan out to the camera's radius of influence
     /// (paper figure 6, top).
@@ -88,14 +90,15 @@ pub struct PuckLook {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightingConfig {
+    /// 0 to 200,000 lux.
     pub sun_illuminance_lux: f32,
     /// Height of the sun above the horizon.
     pub sun_elevation_deg: f32,
     /// Direction the sunlight comes from, around the vertical, from +x towards +z.
     pub sun_azimuth_deg: f32,
-    /// Fill light everywhere, so shadows are not black.
+    /// Fill light everywhere, so shadows are not black; 0 to 100,000 cd/m^2.
     pub ambient_brightness_cd_per_m2: f32,
-    /// Shadows are cast up to this far from the camera.
+    /// Shadows are cast up to this far from the camera; 1 to 100,000 m.
     pub shadow_distance_m: f32,
 }
 
@@ -105,7 +108,7 @@ pub struct HudConfig {
     pub font_size_px: f32,
     /// The game-over banner.
     pub banner_font_size_px: f32,
-    /// The HUD's frame rate and simulation time are averaged over this long.
+    /// The HUD's frame rate and simulation time are averaged over this long; 0.01 to 60 s.
     pub smoothing_s: f32,
     /// One press of `[` `]` or `-` `=` changes a radius of influence by this much.
     pub radius_step_m: f32,
@@ -121,6 +124,7 @@ pub struct CreatureLook {
     /// its width.
     pub body_length_ratio: f32,
     pub body_height_ratio: f32,
+    /// 0.001 to 1 m.
     pub leg_thickness_m: f32,
     /// A nose at the front of the body shows which way a creature faces: its radius as a
     /// share of the body's.
@@ -139,19 +143,19 @@ impl Validate for GameConfig {
     fn validate(&self, v: &mut Validator) {
         let c = &self.camera;
         v.nested("camera", |v| {
-            v.positive("follow_distance_m", c.follow_distance_m);
-            v.positive("follow_height_m", c.follow_height_m);
+            v.range("follow_distance_m", c.follow_distance_m, 0.1, 1000.0);
+            v.range("follow_height_m", c.follow_height_m, 0.1, 1000.0);
             v.within("aim_toward_puck_fraction", c.aim_toward_puck_fraction, 0.0, 1.0);
             v.within("aim_height_m", c.aim_height_m, -20.0, 20.0);
-            v.positive("follow_rate_per_s", c.follow_rate_per_s);
+            v.range("follow_rate_per_s", c.follow_rate_per_s, 0.01, 1000.0);
             v.within("field_of_view_deg", c.field_of_view_deg, 10.0, 150.0);
         });
         let i = &self.inset;
         v.nested("inset", |v| {
             v.within("width_fraction", i.width_fraction, 0.05, 0.9);
             v.within("margin_px", i.margin_px, 0.0, 200.0);
-            v.non_negative("border_m", i.border_m);
-            v.positive("creature_dot_radius_m", i.creature_dot_radius_m);
+            v.range("border_m", i.border_m, 0.0, 10_000.0);
+            v.range("creature_dot_radius_m", i.creature_dot_radius_m, 0.01, 100.0);
             v.within("view_cone_opacity", i.view_cone_opacity, 0.0, 1.0);
         });
         v.nested("level_colours_srgb", |v| {
@@ -184,17 +188,22 @@ impl Validate for GameConfig {
         });
         let l = &self.lighting;
         v.nested("lighting", |v| {
-            v.non_negative("sun_illuminance_lux", l.sun_illuminance_lux);
+            v.range("sun_illuminance_lux", l.sun_illuminance_lux, 0.0, 200_000.0);
             v.within("sun_elevation_deg", l.sun_elevation_deg, 1.0, 90.0);
             v.within("sun_azimuth_deg", l.sun_azimuth_deg, -360.0, 360.0);
-            v.non_negative("ambient_brightness_cd_per_m2", l.ambient_brightness_cd_per_m2);
-            v.positive("shadow_distance_m", l.shadow_distance_m);
+            v.range(
+                "ambient_brightness_cd_per_m2",
+                l.ambient_brightness_cd_per_m2,
+                0.0,
+                100_000.0,
+            );
+            v.range("shadow_distance_m", l.shadow_distance_m, 1.0, 100_000.0);
         });
         let h = &self.hud;
         v.nested("hud", |v| {
             v.within("font_size_px", h.font_size_px, 6.0, 200.0);
             v.within("banner_font_size_px", h.banner_font_size_px, 6.0, 400.0);
-            v.positive("smoothing_s", h.smoothing_s);
+            v.range("smoothing_s", h.smoothing_s, 0.01, 60.0);
             v.within("radius_step_m", h.radius_step_m, 0.1, 10.0);
         });
         let k = &self.creature_look;
@@ -202,7 +211,7 @@ impl Validate for GameConfig {
             v.within("body_radius_fraction", k.body_radius_fraction, 0.1, 3.0);
             v.within("body_length_ratio", k.body_length_ratio, 0.2, 5.0);
             v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
-            v.positive("leg_thickness_m", k.leg_thickness_m);
+            v.range("leg_thickness_m", k.leg_thickness_m, 0.001, 1.0);
             v.within("nose_radius_fraction", k.nose_radius_fraction, 0.05, 1.0);
         });
     }

@@ -9,9 +9,6 @@ use std::path::Path;
 
 /// Parses RON bytes into `T` and validates it; every error names `file`.
 pub fn parse_ron<T: DeserializeOwned + Validate>(bytes: &[u8], file: &Path) -> Result<T, ConfigError> {
-    if bytes.iter().all(u8::is_ascii_whitespace) {
-        return Err(ConfigError::one(file, "", "the file is empty"));
-    }
     let text = std::str::from_utf8(bytes).map_err(|e| {
         ConfigError::one(
             file,
@@ -19,6 +16,11 @@ pub fn parse_ron<T: DeserializeOwned + Validate>(bytes: &[u8], file: &Path) -> R
             format!("not a RON text file: invalid UTF-8 at byte {}", e.valid_up_to()),
         )
     })?;
+    // Some editors start a UTF-8 file with a byte-order mark; it says nothing, so skip it.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    if text.trim().is_empty() {
+        return Err(ConfigError::one(file, "", "the file is empty"));
+    }
     let value: T = parse_text(text).map_err(|(path, e)| parse_error(file, &path, e))?;
     let mut v = Validator::default();
     value.validate(&mut v);
@@ -111,5 +113,24 @@ impl<T: Asset + DeserializeOwned + Validate> AssetLoader for RonAssetLoader<T> {
 
     fn extensions(&self) -> &[&str] {
         &["ron"]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::ArenaConfig;
+
+    #[test]
+    fn a_byte_order_mark_is_skipped_and_alone_is_an_empty_file() {
+        let file = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/arena.ron"));
+        let text = std::fs::read(file).unwrap();
+        let marked = [&[0xef, 0xbb, 0xbf][..], &text].concat();
+        assert_eq!(
+            parse_ron::<ArenaConfig>(&marked, file).unwrap(),
+            parse_ron::<ArenaConfig>(&text, file).unwrap()
+        );
+        let err = parse_ron::<ArenaConfig>(&[0xef, 0xbb, 0xbf, b'\n'], file).unwrap_err();
+        assert!(err.to_string().contains("empty"), "{err}");
     }
 }

@@ -20,7 +20,7 @@ pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, L
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, MAX_CREATURES, MAX_DURATION_S, Scenario};
-pub use validate::{ConfigError, Problem, Validate, Validator};
+pub use validate::{ConfigError, Problem, Validate, Validator, number};
 
 use bevy::prelude::*;
 
@@ -42,7 +42,8 @@ pub struct SimConfig {
 impl SimConfig {
     /// Loads a scenario file and the arena and creature files it names, resolved against
     /// `assets_root` (`arena` is a path under it; a creature kind `k` is
-    /// `creatures/k.ron`). Every problem is reported with the file it is in.
+    /// `creatures/k.ron`). Every problem is reported with the file it is in; a file that
+    /// cannot be read, with the file and field that named it.
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
         Self::load_without_table_of(scenario_path, assets_root, None)
     }
@@ -55,8 +56,8 @@ impl SimConfig {
         without: Option<&str>,
     ) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
-        let arena: ArenaConfig = load_file(&assets_root.join(&scenario.arena))?;
-        let rules: LevelRules = load_file(&assets_root.join(&scenario.level_rules))?;
+        let arena = load_reference(assets_root, scenario_path, "arena", &scenario.arena)?;
+        let rules = load_reference(assets_root, scenario_path, "level_rules", &scenario.level_rules)?;
         Self::assemble(
             scenario_path,
             assets_root,
@@ -64,11 +65,12 @@ impl SimConfig {
             arena,
             rules,
             |i, kind| {
+                let field = format!("creatures[{i}].kind");
                 let path = creature_file(assets_root, kind);
-                if !path.is_file() {
+                if !path.exists() {
                     return Err(ConfigError::one(
                         scenario_path,
-                        format!("creatures[{i}].kind"),
+                        field,
                         format!(
                             "unknown creature kind {kind:?}: there is no {}; known kinds: {}",
                             path.display(),
@@ -76,20 +78,20 @@ impl SimConfig {
                         ),
                     ));
                 }
-                let mut def: CreatureDef = load_file(&path)?;
+                let mut def: CreatureDef = load_reference(assets_root, scenario_path, &field, &kind_file(kind))?;
                 if without == Some(kind) {
                     def.gait_table = None;
                 }
                 Ok(def)
             },
-            |file| load_file(&assets_root.join(file)),
+            |creature, file| load_reference(assets_root, creature, "gait_table", file),
         )
     }
 
     /// Puts a scenario together with its arena, its level rules, the creature kinds it names
     /// and their gait tables, and checks what spans files. `kind_def(i, k)` gives the definition of kind
-    /// `k`, first named by creature group `i`; `gait_table(f)` the table in file `f` (under
-    /// the assets folder). Read from disk by [`SimConfig::load`], taken from the asset
+    /// `k`, first named by creature group `i`; `gait_table(c, f)` the table in file `f` (under
+    /// the assets folder) named by the creature file `c`. Read from disk by [`SimConfig::load`], taken from the asset
     /// server by the game, so both check the same things.
     pub fn assemble(
         scenario_path: &Path,
@@ -98,7 +100,7 @@ impl SimConfig {
         arena: ArenaConfig,
         rules: LevelRules,
         mut kind_def: impl FnMut(usize, &str) -> Result<CreatureDef, ConfigError>,
-        mut gait_table: impl FnMut(&str) -> Result<GaitTable, ConfigError>,
+        mut gait_table: impl FnMut(&Path, &str) -> Result<GaitTable, ConfigError>,
     ) -> Result<Self, ConfigError> {
         let mut kinds = Vec::with_capacity(scenario.creatures.len());
         for (i, group) in scenario.creatures.iter().enumerate() {
@@ -135,7 +137,8 @@ impl SimConfig {
         self.kinds.iter().position(|k| k.name == name)
     }
 
-    /// Checks that span files: every creature fits in the court beside the puck.
+    /// Checks that span files: every creature fits in the court beside the puck, and all of
+    /// them fit at once with their clearance (see [`SimConfig::fit`]).
     fn check_fit(&self, scenario_path: &Path) -> Result<(), ConfigError> {
         let biggest = self.kinds.iter().map(|k| k.body.radius_m).fold(0.0, f32::max);
         let half = self.arena.half_extents();
@@ -149,18 +152,81 @@ impl SimConfig {
                 ),
             ));
         }
+        let fit = self.fit();
+        if fit.needed_m2 > fit.room_m2 {
+            return Err(ConfigError::one(
+                scenario_path,
+                "creatures",
+                format!(
+                    "{} creatures do not fit in the court: with their respawn_creature_clearance_m of {} m they need {:.0} m^2, packed as tightly as circles can be, and the court ({} x {} m) leaves {:.0} m^2 beside the puck: at most about {} of them fit",
+                    self.scenario.creature_count(),
+                    self.arena.respawn_creature_clearance_m,
+                    fit.needed_m2,
+                    self.arena.court_length_m,
+                    self.arena.court_width_m,
+                    fit.room_m2,
+                    fit.most
+                ),
+            ));
+        }
         Ok(())
     }
+
+    /// How much of the court the creatures need. Each takes a disk of its radius plus half
+    /// the clearance (`respawn_creature_clearance_m`) kept between two creatures; the disks'
+    /// centres keep that far from the walls, so all disks lie in the court less half the
+    /// clearance at each wall, beside the puck. No arrangement of equal disks covers more
+    /// than pi / sqrt(12) (0.907) of a plane, so more than that cannot be placed without
+    /// overlaps: placement would fall back to overlapping spots ever more crowded.
+    pub fn fit(&self) -> Fit {
+        const DENSEST_PACKING: f32 = 0.9069;
+        let clear = self.arena.respawn_creature_clearance_m;
+        let disk = |kind: &str| {
+            let r = self
+                .kinds
+                .iter()
+                .find(|k| k.name == kind)
+                .map_or(0.0, |k| k.body.radius_m)
+                + 0.5 * clear;
+            std::f32::consts::PI * r * r
+        };
+        let needed_m2: f32 = self
+            .scenario
+            .creatures
+            .iter()
+            .map(|g| g.count as f32 * disk(&g.kind))
+            .sum();
+        let court = (self.arena.court_length_m - clear).max(0.0) * (self.arena.court_width_m - clear).max(0.0);
+        let puck = std::f32::consts::PI * self.arena.puck.radius_m.powi(2);
+        let room_m2 = ((court - puck) * DENSEST_PACKING).max(0.0);
+        let count = self.scenario.creature_count().max(1) as f32;
+        Fit {
+            needed_m2,
+            room_m2,
+            most: (room_m2 / (needed_m2 / count)).floor() as u64,
+        }
+    }
+}
+
+/// What [`SimConfig::fit`] found.
+#[derive(Clone, Copy, Debug)]
+pub struct Fit {
+    /// The area the creatures need with their clearance.
+    pub needed_m2: f32,
+    /// The most of the court that disks can cover, beside the puck.
+    pub room_m2: f32,
+    /// About how many creatures of this mix fit.
+    pub most: u64,
 }
 
 /// A kind's gait table, checked to be recorded for that kind.
 fn gait_of(
     assets_root: &Path,
     kind: &CreatureDef,
-    gait_table: &mut impl FnMut(&str) -> Result<GaitTable, ConfigError>,
+    gait_table: &mut impl FnMut(&Path, &str) -> Result<GaitTable, ConfigError>,
 ) -> Result<Option<GaitTable>, ConfigError> {
     let Some(file) = &kind.gait_table else { return Ok(None) };
-    let table = gait_table(file)?;
+    let table = gait_table(&creature_file(assets_root, &kind.name), file)?;
     if table.creature != kind.name {
         return Err(ConfigError::one(
             &assets_root.join(file),
@@ -187,7 +253,60 @@ fn gait_of(
 
 /// The file a creature kind is defined in.
 pub fn creature_file(assets_root: &Path, kind: &str) -> PathBuf {
-    assets_root.join("creatures").join(format!("{kind}.ron"))
+    assets_root.join(kind_file(kind))
+}
+
+/// The file of a creature kind, as a path under the assets folder.
+pub fn kind_file(kind: &str) -> String {
+    format!("creatures/{kind}.ron")
+}
+
+/// The file `reference` (under `assets_root`) that field `field` of file `referrer` names,
+/// once it is known to be a file inside the assets folder: not outside it by `..`, an
+/// absolute path or a symbolic link, not a folder, not missing. Errors name the referrer and
+/// its field, and the path.
+pub fn resolve_reference(
+    assets_root: &Path,
+    referrer: &Path,
+    field: &str,
+    reference: &str,
+) -> Result<PathBuf, ConfigError> {
+    let refuse = |why: String| Err(ConfigError::one(referrer, field, why));
+    if let Err(why) = validate::inside_assets(reference) {
+        return refuse(format!("{why}, got {reference:?}"));
+    }
+    let path = assets_root.join(reference);
+    let real = match path.canonicalize() {
+        Ok(real) => real,
+        Err(e) => return refuse(format!("cannot read {}: {e}", path.display())),
+    };
+    match assets_root.canonicalize() {
+        Ok(root) if real.starts_with(&root) => {}
+        _ => {
+            return refuse(format!(
+                "{} leads outside the assets folder {} (through a symbolic link)",
+                path.display(),
+                assets_root.display()
+            ));
+        }
+    }
+    if real.is_dir() {
+        return refuse(format!("{} is a folder, not a file", path.display()));
+    }
+    Ok(path)
+}
+
+/// Reads and parses the file a field of another names (see [`resolve_reference`]).
+fn load_reference<T: serde::de::DeserializeOwned + Validate>(
+    assets_root: &Path,
+    referrer: &Path,
+    field: &str,
+    reference: &str,
+) -> Result<T, ConfigError> {
+    let path = resolve_reference(assets_root, referrer, field, reference)?;
+    let bytes = std::fs::read(&path)
+        .map_err(|e| ConfigError::one(referrer, field, format!("cannot read {}: {e}", path.display())))?;
+    parse_ron(&bytes, &path)
 }
 
 fn known_kinds(assets_root: &Path) -> Vec<String> {
@@ -197,7 +316,7 @@ fn known_kinds(assets_root: &Path) -> Vec<String> {
         .flatten()
         .filter_map(|e| {
             let p = e.path();
-            if p.extension()? == "ron" {
+            if p.extension()? == "ron" && p.is_file() {
                 Some(p.file_stem()?.to_string_lossy().into_owned())
             } else {
                 None

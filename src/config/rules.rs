@@ -9,21 +9,31 @@ use serde::{Deserialize, Serialize};
 pub struct LevelRules {
     pub influence: InfluenceRules,
     pub camera: CameraRules,
+    /// To leave an area a creature must be this much further out than to enter it; 0 to 1000 m.
     pub release_margin_m: f32,
-    /// To leave the camera's view a creature must be this much further outside its cone.
+    /// To leave the camera's view a creature must be this much further outside its cone; 0
+    /// to 90 degrees.
     pub release_margin_deg: f32,
+    /// After a switch a creature keeps its level at least this long; 0 to 3600 s.
     pub min_dwell_s: f32,
-    /// Start and end of the switching window, as parts of the flight phase.
+    /// Start and end of the switching window, as parts of the flight phase (0 to 1).
     pub flight_window: (f32, f32),
+    /// How long what is drawn takes to blend from the old level's motion into the new one's
+    /// after a switch (inertialization); 0 draws the switch as it happens. 0 to 2 s.
+    pub blend_s: f32,
 }
 
 /// Areas of influence (figure 5).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InfluenceRules {
+    /// 0 to 10,000 m.
     pub puck_radius_m: f32,
+    /// 0 to 1000 m.
     pub creature_radius_m: f32,
+    /// 0 to 60 s.
     pub lookahead_s: f32,
+    /// 0 to 10,000 m.
     pub wall_band_m: f32,
 }
 
@@ -31,30 +41,34 @@ pub struct InfluenceRules {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraRules {
+    /// 0 to 10,000 m.
     pub radius_m: f32,
+    /// 1 to 179 degrees.
     pub field_of_view_deg: f32,
+    /// 0 to 1000 m.
     pub follow_distance_m: f32,
 }
 
 impl Validate for LevelRules {
     fn validate(&self, v: &mut Validator) {
         v.nested("influence", |v| {
-            v.non_negative("puck_radius_m", self.influence.puck_radius_m);
-            v.non_negative("creature_radius_m", self.influence.creature_radius_m);
-            v.non_negative("lookahead_s", self.influence.lookahead_s);
-            v.non_negative("wall_band_m", self.influence.wall_band_m);
+            v.range("puck_radius_m", self.influence.puck_radius_m, 0.0, 10_000.0);
+            v.range("creature_radius_m", self.influence.creature_radius_m, 0.0, 1000.0);
+            v.range("lookahead_s", self.influence.lookahead_s, 0.0, 60.0);
+            v.range("wall_band_m", self.influence.wall_band_m, 0.0, 10_000.0);
         });
         v.nested("camera", |v| {
-            v.non_negative("radius_m", self.camera.radius_m);
-            v.within("field_of_view_deg", self.camera.field_of_view_deg, 1.0, 179.0);
-            v.non_negative("follow_distance_m", self.camera.follow_distance_m);
+            v.range("radius_m", self.camera.radius_m, 0.0, 10_000.0);
+            v.range("field_of_view_deg", self.camera.field_of_view_deg, 1.0, 179.0);
+            v.range("follow_distance_m", self.camera.follow_distance_m, 0.0, 1000.0);
         });
-        v.non_negative("release_margin_m", self.release_margin_m);
-        v.within("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
-        v.non_negative("min_dwell_s", self.min_dwell_s);
+        v.range("release_margin_m", self.release_margin_m, 0.0, 1000.0);
+        v.range("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
+        v.range("min_dwell_s", self.min_dwell_s, 0.0, 3600.0);
+        v.range("blend_s", self.blend_s, 0.0, 2.0);
         let (a, b) = self.flight_window;
-        v.within("flight_window.0", a, 0.0, 1.0);
-        v.within("flight_window.1", b, 0.0, 1.0);
+        v.range("flight_window.0", a, 0.0, 1.0);
+        v.range("flight_window.1", b, 0.0, 1.0);
         v.require(
             a < b,
             "flight_window",

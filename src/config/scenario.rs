@@ -10,17 +10,18 @@ use serde::{Deserialize, Serialize};
 pub struct Scenario {
     /// Seeds the world's one RNG: same seed and files, same game.
     pub seed: u64,
-    /// Length of a run when the command line does not say.
+    /// Length of a run when the command line does not say; 0.001 to 10,000 s.
     pub duration_s: f32,
-    /// Simulation ticks per second (the physics step); a multiple of `decision_hz`.
+    /// Simulation ticks per second (the physics step); 30 to 2000, a multiple of `decision_hz`.
     pub tick_hz: u32,
-    /// Steering decisions per second; the paper's frame rate is 30.
+    /// Steering decisions per second, any that divides `tick_hz` (1 Hz up); the paper's frame
+    /// rate is 30.
     pub decision_hz: u32,
-    /// The arena file, relative to the assets folder.
+    /// The arena file, relative to the assets folder and inside it.
     pub arena: String,
     pub creatures: Vec<CreatureGroup>,
     pub level_policy: LevelPolicy,
-    /// The level rules file (relative to the assets folder): influence areas, camera rule,
+    /// The level rules file (relative to the assets folder and inside it): influence areas, camera rule,
     /// switching window.
     pub level_rules: String,
 }
@@ -28,8 +29,10 @@ pub struct Scenario {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreatureGroup {
-    /// A creature kind: the file `creatures/<kind>.ron` under the assets folder.
+    /// A creature kind: the file `creatures/<kind>.ron` under the assets folder; letters,
+    /// digits, '-' and '_' only.
     pub kind: String,
+    /// 0 (the group is left out) to 2,000,000, and at least one creature in all.
     pub count: u32,
 }
 
@@ -67,14 +70,11 @@ impl Validate for Scenario {
                 self.tick_hz, self.decision_hz
             ),
         );
-        v.require(!self.arena.is_empty(), "arena", "must name the arena file");
+        v.asset_path("arena", &self.arena);
+        v.asset_path("level_rules", &self.level_rules);
         v.require(!self.creatures.is_empty(), "creatures", "must list at least one group");
         for (i, g) in self.creatures.iter().enumerate() {
-            v.require(
-                !g.kind.is_empty(),
-                &format!("creatures[{i}].kind"),
-                "must name a creature kind",
-            );
+            v.kind_name(&format!("creatures[{i}].kind"), &g.kind);
         }
         let total: u64 = self.creatures.iter().map(|g| u64::from(g.count)).sum();
         v.require(

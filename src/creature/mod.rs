@@ -8,7 +8,7 @@ use std::ops::Index;
 
 use crate::config::{CreatureDef, LegConfig, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable, LegPose};
-use crate::lod::{LevelChoice, Lod};
+use crate::lod::{DrawnBefore, LevelChoice, Lod};
 use crate::outcome::CollisionRecord;
 use crate::{SimEntity, SimStart, WorldRng};
 use std::collections::HashMap;
@@ -23,6 +23,7 @@ use std::collections::HashMap;
     GaitPose,
     DesiredVelocity,
     CollisionRecord,
+    DrawnBefore,
     SimEntity
 )]
 pub struct Creature {
@@ -284,14 +285,7 @@ pub fn creature_bundle(
 ) -> (Creature, Lod, PlanarState, GaitPhase, GaitPose) {
     let heading = Vec2::from_angle(rng.0.random_range(-std::f32::consts::PI..std::f32::consts::PI));
     let cycle = rng.0.random_range(0.0..1.0);
-    // In the rhythm and pose its level shows from the first frame: a hybrid's are its table's.
-    let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
-        (Lod::Hybrid, Some(table)) => {
-            let (period, stance) = table.rhythm(0.0);
-            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
-        }
-        _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
-    };
+    let (gait, pose) = starting_gait(level, params, cycle, now_s);
     (
         Creature { kind, serial },
         level,
@@ -300,9 +294,22 @@ pub fn creature_bundle(
             velocity: Vec2::ZERO,
             heading,
         },
-        GaitPhase::at(cycle, hop_period_s, stance_fraction, now_s),
+        gait,
         pose,
     )
+}
+
+/// The rhythm and pose a standing creature starts in at `level`, `cycle` into its hop: what
+/// its level shows from the first frame (a hybrid's are its table's).
+pub fn starting_gait(level: Lod, params: &KindParams, cycle: f32, now_s: f32) -> (GaitPhase, GaitPose) {
+    let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
+        (Lod::Hybrid, Some(table)) => {
+            let (period, stance) = table.rhythm(0.0);
+            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
+        }
+        _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
+    };
+    (GaitPhase::at(cycle, hop_period_s, stance_fraction, now_s), pose)
 }
 
 /// Who stands where while the scenario is being placed: a grid that grows one creature at
@@ -339,7 +346,7 @@ impl Occupancy {
 }
 
 /// Places the scenario's creatures in free parts of the court, numbered from 0.
-fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
+pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let kinds = KindTable::of(&config);
     let mut serials = SerialCounter::default();
     let half = config.arena.half_extents();
@@ -356,7 +363,8 @@ fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResM
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
-        let level = config.scenario.level_policy.initial_level(&kinds[kind].levels);
+        // As point masses: each enters its level once all are placed (`lod::select`).
+        let level = Lod::PointMass;
         for _ in 0..group.count {
             // The puck starts at the centre.
             let spot = find_free_spot(&mut rng, half, radius + clear, radius + clear, |p| {
@@ -383,4 +391,28 @@ fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResM
 pub(super) fn plugin(app: &mut App) {
     app.add_systems(SimStart, spawn_creatures.after(crate::arena::spawn_arena));
     steering::plugin(app);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use std::cell::Cell;
+
+    #[test]
+    fn a_full_court_gives_a_spot_after_a_bounded_number_of_tries() {
+        let mut rng = WorldRng(rand::rngs::StdRng::seed_from_u64(1));
+        let asked = Cell::new(0);
+        let half = Vec2::new(3.0, 2.0);
+        // Nowhere is clear enough: the clearest of the tries is taken.
+        let spot = find_free_spot(&mut rng, half, 0.5, 1.0, |p| {
+            asked.set(asked.get() + 1);
+            -p.length()
+        });
+        assert_eq!(asked.get(), PLACEMENT_ATTEMPTS);
+        assert!(spot.x.abs() <= 2.5 && spot.y.abs() <= 1.5, "{spot}");
+        // A margin wider than the court leaves only its centre line, still without a loop.
+        let spot = find_free_spot(&mut rng, half, 10.0, 1.0, |_| 0.0);
+        assert_eq!(spot, Vec2::ZERO);
+    }
 }

@@ -1,17 +1,238 @@
-//! The paper's experiments: `simlod experiment <name> --out DIR` writes their data as CSV.
+//! The paper's experiments (section 4): `simlod experiment <name> --out DIR` writes for each
+//! `<name>.csv` (one row per measurement), `<name>.png` (the plot), `<name>.json` (its summary
+//! figures) and `report.md` (every experiment in that folder beside the paper's numbers).
+//!
+//! Timing experiments (table1, fig7, fig8, fig9) take one measurement at a time in one
+//! process. Outcome trials (fig10) are independent and run on `--jobs` threads, each trial's
+//! simulation on one thread; they can be split into shards and merged.
 
+pub mod fig10;
+pub mod fig7;
+pub mod frame_rate;
+pub mod plot;
+mod progress;
+pub mod report;
 pub mod step_response;
+pub mod table1;
+
+pub use progress::Progress;
 
 /// The side of the square court the single-creature experiments and the gait recorder run
 /// in: room for a long run without meeting a wall.
 pub const EXPERIMENT_COURT_M: f32 = 300.0;
 
 use bevy::prelude::*;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
 
-use crate::config::SimConfig;
+use crate::SimStage;
+use crate::config::{SimConfig, Validate, Validator, load_file};
 use crate::creature::{Creature, DesiredVelocity, PlanarState, PlayerControlled};
 use crate::headless::HeadlessSim;
 use crate::lod::{LevelPolicy, Lod};
+use crate::outcome::Summary;
+
+/// How an experiment is run: flags of `simlod experiment`.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub out: PathBuf,
+    /// The `quick` settings of the experiment's file: small counts, seconds of work.
+    pub quick: bool,
+    /// Overrides the file's trial count.
+    pub trials: Option<u32>,
+    /// Threads for independent trials.
+    pub jobs: usize,
+    /// Run only this part of the trials.
+    pub shard: Shard,
+    /// The assets folder (experiment files name rules files under it).
+    pub assets: PathBuf,
+    /// The scenario file, as given on the command line (for the commands in the report).
+    pub scenario: PathBuf,
+}
+
+/// The `k`-th (from 1) of `n` disjoint parts of an experiment's trials.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Shard {
+    pub k: u32,
+    pub n: u32,
+}
+
+impl Shard {
+    pub const WHOLE: Shard = Shard { k: 1, n: 1 };
+
+    /// Whether unit `i` of the experiment belongs to this shard.
+    pub fn owns(self, i: u32) -> bool {
+        i % self.n == self.k - 1
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let parsed = s
+            .split_once('/')
+            .and_then(|(k, n)| Some((k.trim().parse::<u32>().ok()?, n.trim().parse::<u32>().ok()?)));
+        match parsed {
+            Some((k, n)) if n >= 1 && (1..=n).contains(&k) => Ok(Shard { k, n }),
+            _ => Err(format!("must be K/N with 1 <= K <= N, got {s:?}")),
+        }
+    }
+}
+
+/// An experiment's asset file: the settings of a full run and of `--quick`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperimentFile<S> {
+    pub full: S,
+    pub quick: S,
+}
+
+impl<S: Validate> Validate for ExperimentFile<S> {
+    fn validate(&self, v: &mut Validator) {
+        v.nested("full", |v| self.full.validate(v));
+        v.nested("quick", |v| self.quick.validate(v));
+    }
+}
+
+/// The settings `options` ask for from an experiment file, validated.
+pub fn load_settings<S: DeserializeOwned + Validate>(file: &Path, options: &Options) -> Result<S, String> {
+    let f: ExperimentFile<S> = load_file(file).map_err(|e| e.to_string())?;
+    Ok(if options.quick { f.quick } else { f.full })
+}
+
+/// The trial count: `--trials`, else the file's.
+pub fn trials(options: &Options, from_file: u32) -> u32 {
+    options.trials.unwrap_or(from_file)
+}
+
+/// Checks that a creature kind named in experiment `file` is one the scenario has.
+pub fn check_kind(config: &SimConfig, file: &Path, field: &str, kind: &str) -> Result<(), String> {
+    match config.kind_index(kind) {
+        Some(_) => Ok(()),
+        None => Err(format!(
+            "{}: field `{field}`: the scenario has no creature kind {kind:?}",
+            file.display()
+        )),
+    }
+}
+
+/// The scenario with only creatures of `kind`, `count` of them.
+pub fn only_kind(config: &SimConfig, kind: &str) -> SimConfig {
+    let mut c = config.clone();
+    let count = c.scenario.creature_count();
+    c.scenario.creatures.retain(|g| g.kind == kind);
+    c.scenario.creatures[0].count = count;
+    c
+}
+
+/// Stops the rules and the stages that are not the models' own: levels stay as they are set,
+/// and `stages` (for example steering and collisions) do not run.
+pub fn hold_levels(sim: &mut HeadlessSim, stages: &[SimStage]) {
+    for &stage in [SimStage::SelectLod, SimStage::Switch].iter().chain(stages) {
+        sim.app.configure_sets(FixedUpdate, stage.run_if(|| false));
+    }
+}
+
+/// Runs `config` for `seconds` (whole frames of one steering decision), timing each frame.
+pub fn timed_game(config: SimConfig, seconds: f64) -> (Vec<f64>, Summary) {
+    let mut sim = HeadlessSim::new(config);
+    let mut frames = Vec::new();
+    while sim.clock().seconds() < seconds - 1e-9 {
+        let start = Instant::now();
+        sim.advance_frame();
+        frames.push(start.elapsed().as_secs_f64());
+    }
+    let wall = frames.iter().sum();
+    (frames, sim.summary(wall))
+}
+
+/// Runs `work` on every item on `jobs` threads and hands each result to `done` on this
+/// thread, in the order they finish.
+pub fn run_parallel<T: Sync, R: Send>(
+    items: &[T],
+    jobs: usize,
+    work: impl Fn(&T) -> R + Sync,
+    mut done: impl FnMut(&T, R),
+) {
+    let next = AtomicUsize::new(0);
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, items.len().max(1)) {
+            let send = send.clone();
+            let (next, work) = (&next, &work);
+            scope.spawn(move || {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(item) = items.get(i) else { break };
+                    if send.send((i, work(item))).is_err() {
+                        break;
+                    }
+                }
+            });
+        }
+        drop(send);
+        for (i, result) in receive {
+            done(&items[i], result);
+        }
+    });
+}
+
+/// Writes one of an experiment's files into the output folder.
+pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let path = out.join(file);
+    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(path)
+}
+
+/// What an experiment leaves in its `<name>.json`: its summary figures and the report's
+/// section on it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ExperimentRecord {
+    pub experiment: String,
+    /// The command that regenerates it.
+    pub command: String,
+    pub summary: serde_json::Value,
+    /// Markdown: what the paper reports, what we measured, how they compare.
+    pub report: String,
+}
+
+impl ExperimentRecord {
+    /// Writes `<name>.csv`, `<name>.json` and the report (the plot is drawn before).
+    pub fn finish(&self, out: &Path, csv: &str) -> Result<String, String> {
+        write_out(out, &format!("{}.csv", self.experiment), csv)?;
+        self.save(out)
+    }
+
+    /// Writes `<name>.json` and the report.
+    pub fn save(&self, out: &Path) -> Result<String, String> {
+        let name = &self.experiment;
+        let json = serde_json::to_string_pretty(self).expect("a record serialises");
+        write_out(out, &format!("{name}.json"), &(json + "\n"))?;
+        let report = report::write(out)?;
+        Ok(format!(
+            "{}\nwrote {name}.csv, {name}.png, {name}.json and {} in {}\n",
+            self.report.trim_end(),
+            report
+                .file_name()
+                .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+            out.display()
+        ))
+    }
+}
+
+/// The median of some values (NaN if there are none).
+pub fn median_of(values: impl IntoIterator<Item = f64>) -> f64 {
+    let v: Vec<f64> = values.into_iter().collect();
+    if v.is_empty() {
+        f64::NAN
+    } else {
+        crate::bench::median(v)
+    }
+}
 
 /// A world with one creature of `kind` at the level `policy` gives it, standing at `start`,
 /// steered from outside, the puck parked. The court is grown to `court_m` square so it can
@@ -56,4 +277,50 @@ pub fn stand(world: &mut World, entity: Entity, position: Vec2, heading: Option<
     let level = *e.get::<Lod>().expect("a creature has a level");
     e.insert(level);
     world.flush();
+}
+
+/// The command line that reruns experiment `name` as `options` ran it.
+pub fn command(name: &str, options: &Options) -> String {
+    let mut c = format!("simlod experiment {name} --out {}", options.out.display());
+    if options.scenario != Path::new("assets/scenarios/default.ron") {
+        c += &format!(" --scenario {}", options.scenario.display());
+    }
+    if options.quick {
+        c += " --quick";
+    }
+    if let Some(t) = options.trials {
+        c += &format!(" --trials {t}");
+    }
+    if options.shard != Shard::WHOLE {
+        c += &format!(" --shard {}/{}", options.shard.k, options.shard.n);
+    }
+    c
+}
+
+/// The experiments `simlod experiment all` runs, in the report's order.
+pub const ALL: [&str; 6] = report::ORDER;
+
+/// The experiment file `name` reads unless told otherwise: under the assets folder.
+pub fn default_file(assets: &Path, name: &str) -> PathBuf {
+    assets
+        .join("experiments")
+        .join(format!("{}.ron", name.replace('-', "_")))
+}
+
+/// Runs experiment `name` from `file` into `options.out`; returns what it says.
+pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+    if options.shard != Shard::WHOLE && name != "fig10" {
+        return Err(format!(
+            "--shard splits fig10's trials only; {name} measures one thing at a time on one machine"
+        ));
+    }
+    std::fs::create_dir_all(&options.out).map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
+    match name {
+        "step-response" => step_response::run(config, file, &options.out),
+        "table1" => table1::run(config, file, options),
+        "fig7" => fig7::run(config, file, options),
+        "fig8" | "fig9" => frame_rate::run(name, config, file, options),
+        "fig10" => fig10::run(config, file, options),
+        _ => Err(format!("no experiment {name:?}; there are {}", ALL.join(", "))),
+    }
 }

@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{EXPERIMENT_COURT_M, lone_creature};
+use super::plot::{self, Mark, Panel, Series};
+use super::{EXPERIMENT_COURT_M, ExperimentRecord, lone_creature, write_out};
 
 /// A run starts at least this far inside the experiment's court: 8 s at 3 m/s is 24 m.
 const START_MARGIN_M: f32 = 50.0;
@@ -172,11 +173,82 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
             rigid.x, rigid.y, hybrid.x, hybrid.y
         );
     }
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     for (name, text) in [("velocity.csv", &velocity), ("path.csv", &path), ("final.csv", &last)] {
-        let file = out.join(name);
-        std::fs::write(&file, text).map_err(|e| format!("cannot write {}: {e}", file.display()))?;
+        let file = write_out(out, name, text)?;
         let _ = writeln!(summary, "wrote {}", file.display());
     }
+    draw(&traces, &out.join("step-response.png"))?;
+    let apart = match ends[..] {
+        [rigid, hybrid] => rigid.distance(hybrid),
+        _ => f32::NAN,
+    };
+    let record = ExperimentRecord {
+        experiment: "step-response".into(),
+        command: format!("simlod experiment step-response --out {}", out.display()),
+        summary: serde_json::json!({ "distance_apart_m": apart, "duration_s": experiment.duration_s }),
+        report: format!(
+            "Figures 3 and 4: both models through the same steps of desired velocity (`velocity.csv`, `path.csv`; `final.csv` where they end). \
+             The paper's rigid hopper changes speed only in stance, a hop at a time, while the hybrid answers a step at once and linearly; \
+             \"even small differences in velocity can result in substantial changes in final position\". After {:.1} s ours end {apart:.2} m apart.\n",
+            experiment.duration_s
+        ),
+    };
+    summary += &record.save(out)?;
     Ok(summary)
+}
+
+/// Figure 3 (speed against time) and figure 4 (the paths on the ground) side by side.
+fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
+    let mut speed = Vec::new();
+    let mut path = Vec::new();
+    if let Some(first) = traces.first() {
+        let desired = first
+            .samples
+            .iter()
+            .map(|(t, d, _)| (f64::from(*t), f64::from(d.length())))
+            .collect();
+        speed.push(Series::new("desired", desired, Mark::Dashed, 5));
+    }
+    for (i, tr) in traces.iter().enumerate() {
+        let points = |f: &dyn Fn(&(f32, Vec2, PlanarState)) -> (f32, f32)| -> Vec<(f64, f64)> {
+            tr.samples
+                .iter()
+                .map(f)
+                .map(|(x, y)| (f64::from(x), f64::from(y)))
+                .collect()
+        };
+        speed.push(Series::new(
+            tr.model,
+            points(&|(t, _, s)| (*t, s.velocity.length())),
+            Mark::Line,
+            i,
+        ));
+        path.push(Series::new(
+            tr.model,
+            points(&|(_, _, s)| (s.position.x, s.position.y)),
+            Mark::Line,
+            i,
+        ));
+    }
+    plot::draw(
+        file,
+        1400,
+        600,
+        &[
+            Panel {
+                title: "Figure 3: speed under steps of desired velocity".into(),
+                x_label: "time (s)".into(),
+                y_label: "speed (m/s)".into(),
+                series: speed,
+                ..Panel::default()
+            },
+            Panel {
+                title: "Figure 4: paths on the ground".into(),
+                x_label: "x (m)".into(),
+                y_label: "z (m)".into(),
+                series: path,
+                ..Panel::default()
+            },
+        ],
+    )
 }

@@ -7,7 +7,7 @@ pub mod record;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::config::{RonAssetLoader, Validate, Validator};
+use crate::config::{RonAssetLoader, Validate, Validator, number};
 
 pub use crate::config::MAX_LEGS;
 
@@ -23,6 +23,16 @@ pub fn columns(legs: usize) -> Vec<String> {
         .map(|c| (*c).to_owned())
         .chain((0..legs).flat_map(|i| LEG_COLUMNS.iter().map(move |c| format!("legs[{i}].{c}"))))
         .collect()
+}
+
+/// The range a column is checked against: heights and lengths 0 to 20 m, angles within a
+/// half turn.
+fn column_range(column: &str) -> std::ops::RangeInclusive<f32> {
+    if column.ends_with("_m") {
+        0.0..=20.0
+    } else {
+        -std::f32::consts::PI..=std::f32::consts::PI
+    }
 }
 
 /// One leg's pose, from its hip.
@@ -158,22 +168,6 @@ impl GaitPose {
         pose
     }
 
-    /// Each leg's hip and foot in the world, for a body standing at `position` facing
-    /// `heading`, its hips at `hips` on the body.
-    pub fn hips_and_feet<'a>(
-        &'a self,
-        position: Vec2,
-        heading: Vec2,
-        hips: &'a [Vec3],
-    ) -> impl Iterator<Item = (Vec3, Vec3)> + 'a {
-        let rotation = self.body_rotation(heading);
-        let centre = Vec3::new(position.x, self.body_height_m, position.y);
-        self.legs().iter().zip(hips).map(move |(leg, hip)| {
-            let hip = centre + rotation * *hip;
-            (hip, hip + rotation * leg.direction() * leg.length_m)
-        })
-    }
-
     fn lerp(self, other: Self, t: f32) -> Self {
         let mut pose = Self {
             body_height_m: self.body_height_m + (other.body_height_m - self.body_height_m) * t,
@@ -181,8 +175,8 @@ impl GaitPose {
             pitch_rad: self.pitch_rad + (other.pitch_rad - self.pitch_rad) * t,
             ..self
         };
-        for (leg, o) in pose.legs.iter_mut().zip(other.legs) {
-            *leg = leg.lerp(o, t);
+        for (leg, o) in pose.legs_mut().iter_mut().zip(other.legs()) {
+            *leg = leg.lerp(*o, t);
         }
         pose
     }
@@ -192,14 +186,14 @@ impl GaitPose {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GaitRow {
-    /// The steady forward speed the rigid model ran at (measured).
+    /// The steady forward speed the rigid model ran at (measured); 0 to 50 m/s.
     pub speed_m_per_s: f32,
-    /// Touchdown to touchdown: one step.
+    /// Touchdown to touchdown: one step; 0.05 to 10 s.
     pub hop_period_s: f32,
-    /// Part of each step on the ground, from touchdown.
+    /// Part of each step on the ground, from touchdown; 0 to 1.
     pub stance_fraction: f32,
     /// Poses from the first leg's touchdown on, over the stride, at `sample_hz`; each has the
-    /// table's `columns`.
+    /// table's `columns`: heights and lengths 0 to 20 m, angles -pi to pi rad.
     pub samples: Vec<Vec<f32>>,
 }
 
@@ -208,12 +202,14 @@ pub struct GaitRow {
 #[serde(deny_unknown_fields)]
 pub struct GaitTable {
     pub creature: String,
+    /// 1 to 1000 Hz.
     pub sample_hz: f32,
     /// Steps in a stride: 1 for legs in stance together, the leg count for legs in turn.
     pub steps_per_stride: u32,
     /// The names of a sample's values, in order: [`columns`] of the kind's leg count.
     pub columns: Vec<String>,
-    /// The rigid model's effective limits, which the point mass of the lower levels matches.
+    /// The rigid model's effective limits, which the point mass of the lower levels matches:
+    /// 0.01 to 1000 m/s^2 and 0.01 to 50 m/s.
     pub acceleration_limit_m_per_s2: f32,
     pub top_speed_m_per_s: f32,
     /// In increasing order of speed.
@@ -222,9 +218,14 @@ pub struct GaitTable {
 
 impl Validate for GaitTable {
     fn validate(&self, v: &mut Validator) {
-        v.positive("sample_hz", self.sample_hz);
-        v.positive("acceleration_limit_m_per_s2", self.acceleration_limit_m_per_s2);
-        v.positive("top_speed_m_per_s", self.top_speed_m_per_s);
+        v.range("sample_hz", self.sample_hz, 1.0, 1000.0);
+        v.range(
+            "acceleration_limit_m_per_s2",
+            self.acceleration_limit_m_per_s2,
+            0.01,
+            1000.0,
+        );
+        v.range("top_speed_m_per_s", self.top_speed_m_per_s, 0.01, 50.0);
         let legs = self.leg_count();
         v.require(
             (1..=MAX_LEGS).contains(&legs) && self.columns == columns(legs),
@@ -247,9 +248,9 @@ impl Validate for GaitTable {
         );
         for (i, row) in self.rows.iter().enumerate() {
             v.nested(&format!("rows[{i}]"), |v| {
-                v.non_negative("speed_m_per_s", row.speed_m_per_s);
-                v.positive("hop_period_s", row.hop_period_s);
-                v.within("stance_fraction", row.stance_fraction, 0.0, 1.0);
+                v.range("speed_m_per_s", row.speed_m_per_s, 0.0, 50.0);
+                v.range("hop_period_s", row.hop_period_s, 0.05, 10.0);
+                v.range("stance_fraction", row.stance_fraction, 0.0, 1.0);
                 v.require(!row.samples.is_empty(), "samples", "has no samples");
                 for (j, sample) in row.samples.iter().enumerate() {
                     if sample.len() != self.columns.len() {
@@ -262,10 +263,22 @@ impl Validate for GaitTable {
                                 self.columns.join(", ")
                             ),
                         );
-                    } else if let Some(k) = sample.iter().position(|x| !x.is_finite()) {
+                    } else if let Some((k, r)) = self
+                        .columns
+                        .iter()
+                        .map(|c| column_range(c))
+                        .enumerate()
+                        .find(|(k, r)| !r.contains(&sample[*k]))
+                    {
                         v.fail(
                             &format!("samples[{j}]"),
-                            format!("{} is {}: must be a finite number", self.columns[k], sample[k]),
+                            format!(
+                                "{} is {}: must be between {} and {}",
+                                self.columns[k],
+                                number(sample[k]),
+                                number(*r.start()),
+                                number(*r.end())
+                            ),
                         );
                     }
                 }

@@ -13,7 +13,11 @@ use crate::lod::LevelPolicy;
 
 /// The keys, as the HUD lists them.
 pub const CONTROLS: &str = "WASD / arrows steer   Enter new round   C colour by level   \
-L level policy   [ ] puck radius   - = camera radius   Esc quit";
+L level policy   [ ] puck radius   - = camera radius   P switch pops   Esc quit";
+
+/// Whether the HUD lists the last switches' pops (a debug display).
+#[derive(Resource, Debug, Default)]
+pub struct ShowPops(pub bool);
 
 /// A short message on screen after a key press, with the time it goes away.
 #[derive(Resource, Debug, Default)]
@@ -54,6 +58,7 @@ fn read_game_keys(
     mut rounds: MessageWriter<NewRound>,
     mut exit: MessageWriter<AppExit>,
     mut colour_by_level: ResMut<ColourByLevel>,
+    mut show_pops: ResMut<ShowPops>,
     settings: Res<GameSettings>,
     mut config: ResMut<SimConfig>,
     mut base: ResMut<BaseConfig>,
@@ -77,6 +82,10 @@ fn read_game_keys(
             "colour by level {}",
             if colour_by_level.0 { "on" } else { "off" }
         ));
+    }
+    if keys.just_pressed(KeyCode::KeyP) {
+        show_pops.0 = !show_pops.0;
+        say(format!("switch pops {}", if show_pops.0 { "shown" } else { "hidden" }));
     }
     if keys.just_pressed(KeyCode::KeyL) {
         // Every policy there is, in turn, live: each creature moves to its new level in its
@@ -156,6 +165,7 @@ pub fn policy_name(policy: LevelPolicy) -> String {
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Notice>()
+        .init_resource::<ShowPops>()
         .add_systems(Update, (read_steering_keys, read_game_keys));
 }
 

@@ -13,11 +13,12 @@ use bevy::prelude::*;
 use super::GameSettings;
 use super::player::Round;
 use super::scene::Palette;
+use crate::SimClock;
 use crate::SimEntity;
 use crate::config::SimConfig;
 use crate::creature::{Creature, KindTable, PlanarState};
 use crate::gait::GaitPose;
-use crate::lod::Lod;
+use crate::lod::{Lod, SwitchBlend, drawn};
 
 /// Rapier's bodies face +x; a pose faces -z.
 const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
@@ -145,25 +146,26 @@ fn despawn_orphans(
 }
 
 /// Every level publishes where the body stands and its [`GaitPose`]: the body faces its
-/// heading at its planar position, each leg from its hip on the body to its foot.
+/// heading at its planar position, each leg from its hip on the body to its foot; a creature
+/// that just switched is drawn blended ([`SwitchBlend`]).
 fn pose_creatures(
     kinds: Res<KindTable>,
     settings: Res<GameSettings>,
-    creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPose)>,
+    clock: Res<SimClock>,
+    creatures: Query<(&Creature, &Lod, &PlanarState, &GaitPose, Option<&SwitchBlend>)>,
     mut visuals: Query<(&CreatureVisual, &mut CreaturePose)>,
 ) {
+    let now = clock.seconds() as f32;
     for (visual, mut pose) in &mut visuals {
-        let Ok((creature, &level, state, gait)) = creatures.get(visual.creature) else {
+        let Ok((creature, &level, state, gait, blend)) = creatures.get(visual.creature) else {
             continue;
         };
         let kind = &kinds[creature.kind];
-        let rotation = gait.body_rotation(state.heading);
-        let centre = Vec3::new(state.position.x, gait.body_height_m, state.position.y);
-        pose.body = Transform::from_translation(centre).with_rotation(rotation * RAPIER_TO_POSE);
+        // Blended from the old level's motion for a moment after a switch.
+        let seen = drawn(state, gait, blend, now);
+        pose.body = Transform::from_translation(seen.body).with_rotation(seen.rotation * RAPIER_TO_POSE);
         pose.body_radius_m = kind.radius_m * settings.creature_look.body_radius_fraction;
-        pose.legs = gait
-            .hips_and_feet(state.position, state.heading, &kind.hips_m)
-            .collect();
+        pose.legs = seen.hips_and_feet(&kind.hips_m).collect();
         pose.level = level;
     }
 }

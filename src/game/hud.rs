@@ -8,12 +8,13 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use super::GameSettings;
-use super::controls::{CONTROLS, Notice, policy_name};
+use super::controls::{CONTROLS, Notice, ShowPops, policy_name};
 use super::player::Round;
 use super::reload::Problems;
 use super::scene::{ColourByLevel, srgb};
 use crate::config::SimConfig;
 use crate::lod::Lod;
+use crate::lod::PopTally;
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -174,7 +175,7 @@ fn spawn_hud(mut commands: Commands, settings: Res<GameSettings>) {
         ));
 }
 
-fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConfig) -> String {
+fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConfig, pops: Option<&PopTally>) -> String {
     let mut s = String::new();
     let score = round.score.unwrap_or(super::player::Score {
         survived_s: 0.0,
@@ -207,6 +208,21 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
         rules.influence.puck_radius_m,
         rules.camera.radius_m
     );
+    if let Some(pops) = pops {
+        let _ = write!(s, "\nlast switches, pop as drawn (P hides):");
+        for ((from, to, forced), pop) in pops.recent.iter().rev() {
+            let _ = write!(
+                s,
+                "\n  {} -> {}{}: {:.1} cm, {:.1} deg, {:.2} m/s",
+                from.name(),
+                to.name(),
+                if *forced { " (forced)" } else { "" },
+                pop.metres * 100.0,
+                pop.degrees,
+                pop.velocity_m_per_s
+            );
+        }
+    }
     s
 }
 
@@ -218,11 +234,16 @@ fn show_hud(
     config: Res<SimConfig>,
     problems: Res<Problems>,
     notice: Res<Notice>,
+    show_pops: Res<ShowPops>,
+    pops: Res<PopTally>,
     mut texts: Query<(&HudText, &mut Text, &mut Node)>,
 ) {
     for (which, mut text, mut node) in &mut texts {
         let (shown, wanted) = match which {
-            HudText::Stats => (true, stats_text(&round, &timing, &counts.0, &config)),
+            HudText::Stats => (
+                true,
+                stats_text(&round, &timing, &counts.0, &config, show_pops.0.then_some(&*pops)),
+            ),
             HudText::Level(level) => {
                 let n = counts.0.levels[*level];
                 (true, format!("{} {n}", level.name().replace('_', " ")))

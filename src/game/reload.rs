@@ -8,12 +8,13 @@
 use bevy::asset::{AssetLoadError, AssetLoadFailedEvent, AssetPath, UntypedAssetId};
 use bevy::prelude::*;
 use std::collections::{BTreeMap, HashMap};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
 use crate::config::{
-    ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file,
+    ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file,
+    resolve_reference,
 };
 use crate::gait::GaitTable;
 
@@ -88,10 +89,6 @@ fn watch_files(server: Res<AssetServer>, base: Res<BaseConfig>, mut watched: Res
     }
 }
 
-fn kind_file(kind: &str) -> String {
-    creature_file(Path::new(""), kind).to_string_lossy().replace('\\', "/")
-}
-
 /// The message of a failed load: our own [`ConfigError`] when the file was read but is bad.
 fn failure_text(error: &AssetLoadError) -> String {
     match error {
@@ -151,6 +148,12 @@ fn assemble(
     let Some(scenario) = scenarios.get(&watched.scenario) else {
         return Ok(None);
     };
+    // What the files name must be files inside the assets folder (no symbolic link out of
+    // it) before the asset server is asked for them: the same check as `SimConfig::load`.
+    let root = watched.assets_root.clone();
+    let scenario_path = root.join(&watched.scenario_file);
+    resolve_reference(&root, &scenario_path, "arena", &scenario.arena)?;
+    resolve_reference(&root, &scenario_path, "level_rules", &scenario.level_rules)?;
     let arena_path = AssetPath::parse(&scenario.arena).clone_owned();
     if watched.arena.path() != Some(&arena_path) {
         watched.arena = server.load(arena_path);
@@ -160,7 +163,9 @@ fn assemble(
         watched.rules = server.load(rules_path);
     }
     let mut waiting = false;
-    for group in &scenario.creatures {
+    for (i, group) in scenario.creatures.iter().enumerate() {
+        let field = format!("creatures[{i}].kind");
+        resolve_reference(&root, &scenario_path, &field, &kind_file(&group.kind))?;
         let handle = watched
             .kinds
             .entry(group.kind.clone())
@@ -170,6 +175,7 @@ fn assemble(
             continue;
         };
         if let Some(file) = &kind.gait_table {
+            resolve_reference(&root, &creature_file(&root, &group.kind), "gait_table", file)?;
             let gait = watched
                 .gaits
                 .entry(file.clone())
@@ -183,15 +189,14 @@ fn assemble(
     if waiting {
         return Ok(None);
     }
-    let scenario_path = watched.assets_root.join(&watched.scenario_file);
     SimConfig::assemble(
         &scenario_path,
-        &watched.assets_root,
+        &root,
         scenario.clone(),
         arena.clone(),
         rules.clone(),
         |_, kind| Ok(kinds.get(&watched.kinds[kind]).expect("loaded").clone()),
-        |file| Ok(gaits.get(&watched.gaits[file]).expect("loaded").clone()),
+        |_, file| Ok(gaits.get(&watched.gaits[file]).expect("loaded").clone()),
     )
     .map(Some)
 }

@@ -5,9 +5,7 @@
 
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::time::TimeUpdateStrategy;
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 use crate::SimClock;
 
@@ -70,14 +68,15 @@ fn save(image: &Image, path: &Path) -> AppExit {
 }
 
 pub(super) fn plugin(app: &mut App, path: PathBuf, frames: u32) {
-    let clock = *app.world().resource::<SimClock>();
-    let frame = Duration::from_secs_f64(f64::from(clock.ticks_per_decision) / f64::from(clock.tick_hz));
+    // A frame is one steering decision's ticks, every one of them run (at 1 Hz decisions a
+    // frame is a second of simulation, more than Bevy lets through an update by default).
+    let ticks = app.world().resource::<SimClock>().ticks_per_decision;
+    crate::headless::run_ticks_per_update(app.world_mut(), ticks);
     app.insert_resource(ScreenshotPlan {
         path,
         frames: frames.max(1),
         rendered: 0,
     })
-    .insert_resource(TimeUpdateStrategy::ManualDuration(frame))
     .add_systems(Last, count_frames);
 }
 

@@ -4,9 +4,11 @@
 //! Only levels with a working model behind them exist: the point mass (section 3.3), the
 //! hybrid (3.2) and the rigid body (3.1).
 
+mod blend;
 mod select;
 mod switch;
 
+pub use blend::{Drawn, DrawnBefore, Pop, PopSummary, PopTally, Spread, SwitchBlend, SwitchProbe, drawn};
 pub use select::{CameraFromView, LevelChoice, SimCamera, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 
@@ -158,6 +160,7 @@ impl LevelPolicy {
 pub(super) fn plugin(app: &mut App) {
     select::plugin(app);
     switch::plugin(app);
+    blend::plugin(app);
 }
 
 #[cfg(test)]

@@ -23,9 +23,10 @@ use bevy::prelude::*;
 use super::{LevelPolicy, Lod};
 use crate::arena::{Court, PuckState};
 use crate::config::{LevelRules, SimConfig};
-use crate::creature::{Creature, KindTable, PlanarState, PlayerControlled};
+use crate::creature::{Creature, GaitPhase, KindTable, PlanarState, PlayerControlled, starting_gait};
+use crate::gait::GaitPose;
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage};
+use crate::{SimClock, SimStage, SimStart};
 
 /// The level the rules want for a creature, and when it last switched.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
@@ -33,6 +34,8 @@ pub struct LevelChoice {
     pub wanted: Lod,
     /// Simulated time of the last switch (for `min_dwell_s`).
     pub last_switch_s: f32,
+    /// Whether it has switched since it was spawned.
+    pub switched: bool,
 }
 
 /// The camera of the camera rule, on the ground plane. Headless it follows a creature
@@ -102,7 +105,26 @@ struct LevelInputs<'a> {
     reach_m: f32,
 }
 
-impl LevelInputs<'_> {
+impl<'a> LevelInputs<'a> {
+    fn new(
+        rules: &'a LevelRules,
+        kinds: &KindTable,
+        puck: &'a PuckState,
+        court: &'a Court,
+        grid: &'a NeighbourGrid,
+        camera: &'a SimCamera,
+    ) -> Self {
+        let top_speed = kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
+        Self {
+            rules,
+            puck,
+            court,
+            grid,
+            camera,
+            reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
+        }
+    }
+
     fn influence_level(&self, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
         let la = self.rules.influence.lookahead_s;
         let near_wall = (self.court.half_extents - s.position.abs()).min_element() <= r.wall;
@@ -208,15 +230,7 @@ fn select_levels(
     }
     let rules = &config.rules;
     let policy = config.scenario.level_policy;
-    let top_speed = kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
-    let inputs = LevelInputs {
-        rules,
-        puck: &puck,
-        court: &court,
-        grid: &grid,
-        camera: &camera,
-        reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
-    };
+    let inputs = LevelInputs::new(rules, &kinds, &puck, &court, &grid, &camera);
     let (enter, leave) = (
         Radii::of(rules, camera.half_view_rad, false),
         Radii::of(rules, camera.half_view_rad, true),
@@ -251,9 +265,60 @@ fn select_levels(
     settled.0 = !policy.is_dynamic() && creatures.iter().all(|(_, lod, _, choice)| *lod == choice.wanted);
 }
 
+/// A new world's creatures, placed as point masses, start at the level the policy gives them
+/// where they stand, in the rhythm and pose of that level, not at a default level they would
+/// leave in their first flight window. Every policy's levels are entered here, in one order,
+/// so that a puck area covering the court is the all-rigid game bit for bit.
+fn start_at_selected_levels(
+    mut commands: Commands,
+    clock: Res<SimClock>,
+    config: Res<SimConfig>,
+    kinds: Res<KindTable>,
+    puck: Res<PuckState>,
+    court: Res<Court>,
+    grid: Res<NeighbourGrid>,
+    camera: Res<SimCamera>,
+    mut creatures: Query<(
+        Entity,
+        &Creature,
+        &Lod,
+        &PlanarState,
+        &mut GaitPhase,
+        &mut GaitPose,
+        &mut LevelChoice,
+    )>,
+) {
+    let policy = config.scenario.level_policy;
+    let inputs = LevelInputs::new(&config.rules, &kinds, &puck, &court, &grid, &camera);
+    let enter = Radii::of(&config.rules, camera.half_view_rad, false);
+    for (entity, c, &lod, s, mut gait, mut pose, mut choice) in &mut creatures {
+        let kind = &kinds[c.kind];
+        let level = if policy.is_dynamic() {
+            kind.best_level(inputs.level(policy, c, s, &enter))
+        } else {
+            policy.initial_level(&kind.levels)
+        };
+        if level != lod {
+            (*gait, *pose) = starting_gait(level, kind, gait.cycle, clock.seconds() as f32);
+            // Its new level's model is built as it enters it (the level's observers).
+            commands.entity(entity).insert(level);
+        }
+        choice.wanted = level;
+    }
+}
+
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<SimCamera>()
         .init_resource::<LevelsSettled>()
+        .add_systems(
+            SimStart,
+            (
+                place_camera.run_if(not(resource_exists::<CameraFromView>)),
+                start_at_selected_levels,
+            )
+                .chain()
+                .after(crate::sense::index_creatures),
+        )
         .add_systems(
             FixedUpdate,
             (

@@ -11,8 +11,10 @@
 use bevy::prelude::*;
 
 use super::Lod;
+use super::blend::{Drawn, DrawnBefore, SwitchBlend, SwitchProbe};
 use super::select::{LevelChoice, levels_may_change};
-use crate::creature::{Creature, GaitPhase, KindTable};
+use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
+use crate::gait::GaitPose;
 use crate::outcome::{CollisionRecord, Counts, SwitchCounts};
 use crate::{SimClock, SimStage, SimStart};
 
@@ -46,23 +48,51 @@ fn switch_levels(
     kinds: Res<KindTable>,
     mut tally: ResMut<SwitchTally>,
     mut switched: MessageWriter<LevelSwitched>,
-    mut creatures: Query<(Entity, &Creature, &Lod, &mut LevelChoice, &GaitPhase, &CollisionRecord)>,
+    mut creatures: Query<(
+        Entity,
+        &Creature,
+        &Lod,
+        &mut LevelChoice,
+        &GaitPhase,
+        &CollisionRecord,
+        (&PlanarState, &GaitPose, Option<&SwitchBlend>, &mut DrawnBefore),
+    )>,
 ) {
     let now = clock.seconds() as f32;
     let (open, close) = config.rules.flight_window;
-    for (entity, creature, &lod, mut choice, gait, record) in &mut creatures {
+    for (entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before)) in &mut creatures {
         let kind = &kinds[creature.kind];
         let forced =
             lod != Lod::Rigid && record.touching.iter().any(|&t| t) && kind.best_level(Lod::Rigid) == Lod::Rigid;
         let target = if forced { Lod::Rigid } else { choice.wanted };
         if target == lod {
+            if before.0.is_some() {
+                before.0 = None;
+            }
             continue;
         }
+        // What is drawn now (as the last tick left it), blended and by the model alone.
+        let model = Drawn::of(state, pose);
+        let seen = (blend.map_or(model, |b| b.apply(&model, now)), model);
         let progress = gait.flight_progress();
         if !forced && !progress.is_some_and(|p| (open..=close).contains(&p)) {
+            before.0 = Some(seen);
             continue;
         }
-        commands.entity(entity).insert(target);
+        // A creature that switches without waiting (a collision) has no drawing kept from
+        // the tick before: its body is taken to have moved at its velocity, its legs to have
+        // held still.
+        let earlier = before.0.take().unwrap_or_else(|| {
+            let back = |d: Drawn| Drawn {
+                body: d.body - Vec3::new(state.velocity.x, 0.0, state.velocity.y) * clock.dt,
+                ..d
+            };
+            (back(seen.0), back(seen.1))
+        });
+        commands.entity(entity).insert((
+            target,
+            SwitchProbe::new(lod, target, forced, [earlier.0, seen.0], [earlier.1, seen.1]),
+        ));
         tally.switches.count(lod, target);
         switched.write(LevelSwitched {
             creature: entity,
@@ -75,6 +105,7 @@ fn switch_levels(
         *choice = LevelChoice {
             wanted: target,
             last_switch_s: now,
+            switched: true,
         };
     }
 }

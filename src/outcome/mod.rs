@@ -20,8 +20,10 @@ use std::sync::Mutex;
 
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
-use crate::creature::{Creature, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot};
-use crate::lod::{AtRigid, Lod, SwitchTally};
+use crate::creature::{
+    Creature, GaitPhase, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
+};
+use crate::lod::{AtRigid, LevelChoice, Lod, PopSummary, PopTally, SwitchTally};
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart, WorldRng};
 
@@ -89,6 +91,8 @@ pub struct Tally {
     /// Removed creatures that had collided with the puck or a wall.
     pub removed_collided: u64,
     pub falls: u64,
+    /// Falls within one step of a switch into the rigid level.
+    pub falls_after_switch: u64,
     pub respawns: u64,
 }
 
@@ -210,7 +214,7 @@ fn respawn_fallen(
     mut tally: ResMut<Tally>,
     mut rng: ResMut<WorldRng>,
     mut serials: ResMut<SerialCounter>,
-    creatures: Query<(&Creature, &Lod, &CollisionRecord)>,
+    creatures: Query<(&Creature, &Lod, &CollisionRecord, &LevelChoice, &GaitPhase)>,
 ) {
     let mut fallen = std::mem::take(&mut *falls.0.lock().unwrap_or_else(|p| p.into_inner()));
     if fallen.is_empty() {
@@ -223,9 +227,12 @@ fn respawn_fallen(
     let clear = config.arena.respawn_creature_clearance_m;
     let puck_keep_out = puck.radius_m + config.arena.respawn_puck_clearance_m;
     for (_, entity) in fallen {
-        let Ok((creature, lod, record)) = creatures.get(entity) else {
+        let Ok((creature, lod, record, choice, gait)) = creatures.get(entity) else {
             continue;
         };
+        let now = clock.seconds() as f32;
+        tally.falls_after_switch +=
+            u64::from(*lod == Lod::Rigid && choice.switched && now - choice.last_switch_s < gait.hop_period_s);
         for o in Obstacle::ALL {
             tally.removed_collisions[o] += u64::from(record.count[o as usize]);
         }
@@ -250,7 +257,7 @@ fn respawn_fallen(
     }
 }
 
-fn advance_clock(mut clock: ResMut<SimClock>) {
+pub(crate) fn advance_clock(mut clock: ResMut<SimClock>) {
     clock.tick += 1;
 }
 
@@ -265,6 +272,8 @@ pub struct Summary {
     /// Creatures that collided with the puck or a wall (the paper's figure 10 measure).
     pub creatures_collided: u64,
     pub falls: u64,
+    /// Falls within one step (touchdown to touchdown) of a switch into the rigid level.
+    pub falls_after_switch: u64,
     pub respawns: u64,
     /// Creatures at each level at the end.
     pub levels: Counts<Lod, u64>,
@@ -273,6 +282,9 @@ pub struct Summary {
     /// Creatures at each level, averaged over the run's steering decisions, and the peak.
     pub levels_mean: Counts<Lod, f64>,
     pub levels_peak: Counts<Lod, u64>,
+    /// The pops of the switches in what is drawn, by kind of switch (from, to, forced by a
+    /// collision or not): the largest and the 95th percentile.
+    pub pops: Vec<PopSummary>,
     pub sim_seconds: f64,
     /// Wall-clock seconds; the only field that differs between identical runs.
     pub wall_seconds: f64,
@@ -299,16 +311,19 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     }
     let sim_seconds = clock.seconds();
     let switching = world.resource::<SwitchTally>().clone();
+    let pops = world.resource::<PopTally>().summary();
     let samples = switching.samples.max(1) as f64;
     Summary {
         switches: switching.switches,
         levels_mean: Counts::from_fn(|l| switching.level_sums[l] as f64 / samples),
         levels_peak: switching.level_peaks,
+        pops,
         seed,
         creatures,
         collisions,
         creatures_collided: collided,
         falls: tally.falls,
+        falls_after_switch: tally.falls_after_switch,
         respawns: tally.respawns,
         levels,
         sim_seconds,

@@ -127,7 +127,7 @@ const EMPTY: Neighbour = Neighbour {
 };
 
 /// Rebuilds the index at each steering decision.
-fn index_creatures(
+pub(crate) fn index_creatures(
     clock: Res<SimClock>,
     kinds: Res<KindTable>,
     mut grid: ResMut<NeighbourGrid>,
@@ -149,7 +149,7 @@ fn index_creatures(
 }
 
 /// A grid sized for the court and the largest creature's reach.
-fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
+pub(crate) fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
     let cell_m = config
         .kinds
         .iter()
@@ -159,8 +159,14 @@ fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(SimStart, size_grid)
-        .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
+    // The index of the creatures as placed, for the rules that give each its first level.
+    app.add_systems(
+        SimStart,
+        (size_grid, index_creatures)
+            .chain()
+            .after(crate::creature::spawn_creatures),
+    )
+    .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use crate::support::*;
 use simlod::config::{ArenaConfig, ConfigError, CreatureDef, Scenario, SimConfig, load_file};
 
 /// A copy of the shipped assets in a scratch folder, with one file replaced.
-fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
+pub(crate) fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
     let dir = scratch_dir(test);
     for sub in ["", "creatures", "scenarios", "rules", "gaits"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
@@ -24,7 +24,7 @@ fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
 }
 
 /// The shipped file with `from` replaced by `to`.
-fn edited(file: &str, from: &str, to: &str) -> Vec<u8> {
+pub(crate) fn edited(file: &str, from: &str, to: &str) -> Vec<u8> {
     let text = std::fs::read_to_string(assets_root().join(file)).unwrap();
     assert!(text.contains(from), "{file} has no {from:?}");
     text.replacen(from, to, 1).into_bytes()
@@ -82,7 +82,12 @@ fn a_negative_mass_is_refused() {
         "creatures/hopper.ron",
         &edited("creatures/hopper.ron", "mass_kg: 10.0", "mass_kg: -10.0"),
     );
-    assert_names(&err, "creatures/hopper.ron", "body.mass_kg", "greater than 0, got -10");
+    assert_names(
+        &err,
+        "creatures/hopper.ron",
+        "body.mass_kg",
+        "between 0.01 and 10000 kg, got -10",
+    );
 }
 
 #[test]
@@ -128,7 +133,7 @@ fn a_court_too_large_to_index_is_refused() {
         "arena.ron",
         &edited("arena.ron", "court_width_m: 40.0", "court_width_m: 1e6"),
     );
-    assert_names(&err, "arena.ron", "court_width_m", "at most");
+    assert_names(&err, "arena.ron", "court_width_m", "between 1 and 10000 m, got 1e6");
 }
 
 #[test]
@@ -241,7 +246,273 @@ fn the_asset_server_reports_a_broken_file_with_the_same_message() {
     );
     let err = load_through_asset_server::<ArenaConfig>(&root, "arena.ron").unwrap_err();
     assert!(
-        err.contains("`puck.mass_kg`") && err.contains("greater than 0"),
+        err.contains("`puck.mass_kg`") && err.contains("between 0.1 and 1e6 kg, got -1"),
         "{err}"
     );
+}
+
+#[test]
+fn absurd_sizes_masses_speeds_and_rates_are_refused_with_the_unit() {
+    for (file, from, to, field, says) in [
+        (
+            "arena.ron",
+            "wall_thickness_m: 0.5",
+            "wall_thickness_m: 1e30",
+            "wall_thickness_m",
+            "between 0.01 and 100 m, got 1e30",
+        ),
+        (
+            "arena.ron",
+            "mass_kg: 5000.0",
+            "mass_kg: 1e12",
+            "puck.mass_kg",
+            "kg, got 1e12",
+        ),
+        (
+            "arena.ron",
+            "speed_m_per_s: 5.0",
+            "speed_m_per_s: 1e5",
+            "puck.speed_m_per_s",
+            "m/s, got 100000",
+        ),
+        (
+            "creatures/biped.ron",
+            "radius_m: 0.35",
+            "radius_m: 1e30",
+            "body.radius_m",
+            "between 0.01 and 10 m",
+        ),
+        (
+            "creatures/biped.ron",
+            "hop_period_s: 0.4",
+            "hop_period_s: 1e-9",
+            "hop_period_s",
+            "0.05 and 10 s",
+        ),
+        (
+            "creatures/biped.ron",
+            "separation_distance_m: 1.6",
+            "separation_distance_m: 1e9",
+            "steering.separation_distance_m",
+            "0 and 100 m",
+        ),
+        (
+            "rules/levels.ron",
+            "lookahead_s: 1.0",
+            "lookahead_s: 1e20",
+            "influence.lookahead_s",
+            "0 and 60 s",
+        ),
+        (
+            "gaits/hopper.ron",
+            "sample_hz: 30.0",
+            "sample_hz: 1e9",
+            "sample_hz",
+            "1 and 1000 hz",
+        ),
+        (
+            "gaits/hopper.ron",
+            "[0.7899582,",
+            "[1e30,",
+            "rows[0].samples[0]",
+            "body_height_m is 1e30",
+        ),
+    ] {
+        let err = load_error("absurd", file, &edited(file, from, to));
+        assert_names(&err, file, field, says);
+    }
+}
+
+#[test]
+fn a_reference_out_of_the_assets_folder_is_refused_naming_the_field() {
+    let scenario = "scenarios/default.ron";
+    let hopper = "creatures/hopper.ron";
+    for (file, from, to, field, says) in [
+        (
+            scenario,
+            "\"arena.ron\"",
+            "\"../arena.ron\"",
+            "arena",
+            "inside the assets folder",
+        ),
+        (
+            scenario,
+            "\"arena.ron\"",
+            "\"/etc/passwd\"",
+            "arena",
+            "relative to the assets folder",
+        ),
+        (
+            scenario,
+            "\"rules/levels.ron\"",
+            "\"rules/../../x.ron\"",
+            "level_rules",
+            "inside the assets folder",
+        ),
+        (
+            scenario,
+            "\"biped\"",
+            "\"../../x\"",
+            "creatures[1].kind",
+            "letters, digits",
+        ),
+        (
+            hopper,
+            "\"gaits/hopper.ron\"",
+            "\"../gaits/hopper.ron\"",
+            "gait_table",
+            "inside the assets folder",
+        ),
+    ] {
+        let err = load_error("outside", file, &edited(file, from, to));
+        assert_names(&err, file, field, says);
+    }
+}
+
+#[cfg(unix)]
+#[test]
+fn a_symbolic_link_out_of_the_assets_folder_is_refused() {
+    let root = assets_with("symlink_out", "arena.ron", b"");
+    let outside = root.parent().unwrap().join("symlink_out_secret.ron");
+    std::fs::copy(assets_root().join("arena.ron"), &outside).unwrap();
+    std::fs::remove_file(root.join("arena.ron")).unwrap();
+    std::os::unix::fs::symlink(&outside, root.join("arena.ron")).unwrap();
+    let err = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap_err();
+    assert_names(
+        &err,
+        "scenarios/default.ron",
+        "arena",
+        "leads outside the assets folder",
+    );
+    // A link that stays inside the folder is followed.
+    std::fs::remove_file(root.join("arena.ron")).unwrap();
+    std::fs::copy(&outside, root.join("rules/arena.ron")).unwrap();
+    std::os::unix::fs::symlink(root.join("rules/arena.ron"), root.join("arena.ron")).unwrap();
+    SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
+}
+
+#[test]
+fn the_asset_server_refuses_a_reference_out_of_the_folder_as_the_file_path_does() {
+    let root = assets_with(
+        "asset_server_outside",
+        "scenarios/default.ron",
+        &edited("scenarios/default.ron", "\"arena.ron\"", "\"../arena.ron\""),
+    );
+    let err = load_through_asset_server::<Scenario>(&root, "scenarios/default.ron").unwrap_err();
+    assert!(
+        err.contains("`arena`") && err.contains("inside the assets folder"),
+        "{err}"
+    );
+}
+
+#[test]
+fn an_empty_gait_table_name_is_named_in_the_creature_file() {
+    let err = load_error(
+        "empty_gait",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "\"gaits/hopper.ron\"", "\"\""),
+    );
+    assert_names(&err, "creatures/hopper.ron", "gait_table", "must name a file");
+}
+
+#[test]
+fn a_missing_referenced_file_names_the_file_and_field_that_refer_to_it() {
+    let err = load_error(
+        "missing_ref",
+        "scenarios/default.ron",
+        &edited("scenarios/default.ron", "\"rules/levels.ron\"", "\"rules/gone.ron\""),
+    );
+    assert_names(&err, "scenarios/default.ron", "level_rules", "cannot read");
+    assert!(err.to_string().contains("rules/gone.ron"), "{err}");
+    let err = load_error(
+        "missing_gait",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "\"gaits/hopper.ron\"", "\"gaits/gone.ron\""),
+    );
+    assert_names(&err, "creatures/hopper.ron", "gait_table", "cannot read");
+    assert!(err.to_string().contains("gaits/gone.ron"), "{err}");
+}
+
+#[test]
+fn a_file_starting_with_a_byte_order_mark_loads() {
+    let marked = [
+        &[0xef, 0xbb, 0xbf][..],
+        &edited("scenarios/default.ron", "seed: 7", "seed: 7"),
+    ]
+    .concat();
+    let root = assets_with("bom", "scenarios/default.ron", &marked);
+    let config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
+    assert_eq!(config.scenario, default_config().scenario);
+}
+
+#[test]
+fn a_kind_whose_file_is_a_folder_is_refused_as_a_folder() {
+    let root = assets_with(
+        "kind_folder",
+        "scenarios/default.ron",
+        &edited("scenarios/default.ron", "\"biped\"", "\"tripod\""),
+    );
+    std::fs::create_dir_all(root.join("creatures/tripod.ron")).unwrap();
+    let err = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap_err();
+    assert_names(
+        &err,
+        "scenarios/default.ron",
+        "creatures[1].kind",
+        "is a folder, not a file",
+    );
+    std::fs::remove_dir(root.join("creatures/tripod.ron")).unwrap();
+    std::fs::create_dir_all(root.join("creatures/quad.ron")).unwrap();
+    let err = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap_err();
+    assert!(err.to_string().ends_with("known kinds: biped, hopper"), "{err}");
+}
+
+#[test]
+fn values_of_the_wrong_type_are_named_by_their_whole_path() {
+    for (file, from, to, field) in [
+        (
+            "creatures/hopper.ron",
+            "max_tilt_deg: 45.0",
+            "max_tilt_deg: [1]",
+            "rigid.fall.max_tilt_deg",
+        ),
+        (
+            "creatures/hopper.ron",
+            "Some(\"gaits/hopper.ron\")",
+            "Some(3)",
+            "gait_table",
+        ),
+        ("scenarios/default.ron", "count: 10", "count: -1", "creatures[1].count"),
+        (
+            "scenarios/default.ron",
+            "(kind: \"biped\"",
+            "(kind: 3",
+            "creatures[1].kind",
+        ),
+        (
+            "rules/levels.ron",
+            "flight_window: (0.1",
+            "flight_window: (\"a\"",
+            "flight_window[0]",
+        ),
+        ("gaits/hopper.ron", "[0.7899582,", "[\"x\",", "rows[0].samples[0][0]"),
+    ] {
+        let err = load_error("wrong_types", file, &edited(file, from, to));
+        assert_names(&err, file, field, "line");
+    }
+}
+
+#[test]
+fn more_creatures_than_the_court_can_hold_are_refused_at_once_with_the_numbers() {
+    let err = load_error(
+        "too_many",
+        "scenarios/default.ron",
+        &edited("scenarios/default.ron", "count: 30", "count: 100000"),
+    );
+    assert_names(
+        &err,
+        "scenarios/default.ron",
+        "creatures",
+        "100010 creatures do not fit",
+    );
+    assert!(err.to_string().contains("at most about 1032"), "{err}");
 }

@@ -78,3 +78,20 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
         "--speeds",
     );
 }
+
+#[test]
+fn experiment_flags_are_checked() {
+    refused(
+        &["experiment", "fig10", "--quick", "--out", "/tmp/x", "--shard", "3/2"],
+        "K/N",
+    );
+    refused(
+        &["experiment", "fig8", "--quick", "--out", "/tmp/x", "--shard", "1/2"],
+        "--shard",
+    );
+    refused(
+        &["experiment", "fig10", "--quick", "--out", "/tmp/x", "--jobs", "0"],
+        "--jobs",
+    );
+    refused(&["experiment", "merge", "/nowhere", "--out", "/tmp/x"], "/nowhere");
+}

@@ -77,3 +77,231 @@ fn step_response_refuses_a_broken_experiment_file() {
     let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
     assert!(err.contains("`duration_s`") && err.contains("`steps`"), "{err}");
 }
+
+use simlod::experiments::{self, Options, Shard};
+use simlod::headless::HeadlessSim;
+use simlod::lod::LevelPolicy;
+use std::path::{Path, PathBuf};
+
+fn quick(out: &Path) -> Options {
+    Options {
+        out: out.to_owned(),
+        quick: true,
+        trials: None,
+        jobs: 2,
+        shard: Shard::WHOLE,
+        assets: assets_root(),
+        scenario: assets_root().join("scenarios/default.ron"),
+    }
+}
+
+fn run(name: &str, options: &Options) -> Result<String, String> {
+    experiments::run_named(
+        name,
+        &default_config(),
+        &experiments::default_file(&assets_root(), name),
+        options,
+    )
+}
+
+/// Share of pixels that are not the background, and how many colours there are.
+fn ink(png: &Path) -> (f64, usize) {
+    let img = image::open(png)
+        .unwrap_or_else(|e| panic!("{}: {e}", png.display()))
+        .to_rgb8();
+    let white = image::Rgb([255u8, 255, 255]);
+    let inked = img.pixels().filter(|p| **p != white).count();
+    let colours: std::collections::BTreeSet<[u8; 3]> = img.pixels().map(|p| p.0).collect();
+    (inked as f64 / img.pixels().len() as f64, colours.len())
+}
+
+#[test]
+fn every_experiment_quick_writes_its_files_and_a_plot_that_is_not_blank() {
+    let out = scratch_dir("experiments_quick");
+    for name in ["table1", "fig7", "fig8", "fig9", "fig10"] {
+        let said = run(name, &quick(&out)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(said.contains(&format!("wrote {name}.csv")), "{said}");
+        for ext in ["csv", "png", "json"] {
+            assert!(out.join(format!("{name}.{ext}")).is_file(), "{name}.{ext}");
+        }
+        let csv = std::fs::read_to_string(out.join(format!("{name}.csv"))).unwrap();
+        assert!(csv.lines().count() >= 2, "{name}.csv has rows: {csv}");
+        let (share, colours) = ink(&out.join(format!("{name}.png")));
+        assert!(
+            share > 0.01 && colours > 8,
+            "{name}.png is blank: {share} inked, {colours} colours"
+        );
+        let record: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join(format!("{name}.json"))).unwrap()).unwrap();
+        assert_eq!(record["experiment"], name);
+    }
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    for name in ["table1", "fig7", "fig8", "fig9", "fig10"] {
+        assert!(
+            report.contains(&format!("![{name}]({name}.png)")),
+            "report.md shows {name}"
+        );
+    }
+    assert!(
+        report.contains("2.4") && report.contains("112"),
+        "the paper's numbers: {report}"
+    );
+}
+
+/// The paper's fig10 set-up at a puck radius that covers the whole court: every creature is
+/// rigid from the start, so the game is the all-rigid one, bit for bit.
+#[test]
+fn a_puck_area_covering_the_court_is_the_all_rigid_game_from_the_first_tick() {
+    let mut config = default_config();
+    config.rules.influence.puck_radius_m = 1000.0;
+    config.scenario.level_policy = LevelPolicy::Influence;
+    let mut rigid = config.clone();
+    rigid.scenario.level_policy = LevelPolicy::AllRigid;
+    let (mut a, mut b) = (HeadlessSim::new(config), HeadlessSim::new(rigid));
+    for frame in 0..90 {
+        assert_eq!(a.state_digest(), b.state_digest(), "frame {frame}");
+        a.advance_frame();
+        b.advance_frame();
+    }
+    let (sa, sb) = (a.summary(0.0), b.summary(0.0));
+    assert_eq!(sa.levels, sb.levels);
+    assert_eq!(sa.switches.total(), 0, "nobody waited for a flight window");
+}
+
+#[test]
+fn a_creature_starts_at_the_level_the_rules_give_it_where_it_stands() {
+    let mut config = default_config();
+    config.scenario.level_policy = LevelPolicy::Influence;
+    config.rules.influence.puck_radius_m = 6.0;
+    let mut sim = HeadlessSim::new(config);
+    let world = sim.app.world_mut();
+    let levels: Vec<simlod::lod::Lod> = world.query::<&simlod::lod::Lod>().iter(world).copied().collect();
+    // Before any tick: hoppers near the puck, a wall or another creature rigid, the rest hybrid.
+    let rigid = levels.iter().filter(|l| **l == simlod::lod::Lod::Rigid).count();
+    let hybrid = levels.iter().filter(|l| **l == simlod::lod::Lod::Hybrid).count();
+    assert!(rigid > 0 && hybrid > 0, "{rigid} rigid, {hybrid} hybrid at the start");
+}
+
+fn fig10_file(dir: &Path, radii: &str, seconds: f32, trials: u32) -> PathBuf {
+    let file = dir.join("fig10.ron");
+    let s = format!(
+        "(radii_m: [{radii}], rules: \"rules/puck-only.ron\", seconds: {seconds}, trials: {trials}, first_seed: 40)"
+    );
+    std::fs::write(&file, format!("(full: {s}, quick: {s})")).unwrap();
+    file
+}
+
+fn fig10(file: &Path, options: &Options) -> Vec<Vec<String>> {
+    experiments::fig10::run(&default_config(), file, options).unwrap();
+    table(&options.out.join("fig10.csv"))
+}
+
+fn table(csv: &Path) -> Vec<Vec<String>> {
+    std::fs::read_to_string(csv)
+        .unwrap()
+        .lines()
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect()
+}
+
+/// Everything but the wall times (the last two columns), which are measurements.
+fn outcomes(rows: &[Vec<String>]) -> Vec<Vec<String>> {
+    rows.iter().map(|r| r[..r.len() - 2].to_vec()).collect()
+}
+
+#[test]
+fn fig10_at_a_radius_covering_the_court_differs_from_all_rigid_by_zero_in_every_trial() {
+    let dir = scratch_dir("fig10_court");
+    let file = fig10_file(&dir, "1000.0", 6.0, 3);
+    let rows = fig10(&file, &quick(&dir.join("out")));
+    let header = &rows[0];
+    let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+    assert_eq!(rows.len(), 4);
+    let mut collided = 0;
+    for r in &rows[1..] {
+        assert_eq!(r[col("difference")], "0", "{r:?}");
+        assert_eq!(r[col("falls")], r[col("falls_all_rigid")], "{r:?}");
+        collided += r[col("collided_all_rigid")].parse::<u64>().unwrap();
+    }
+    assert!(collided > 0, "the trials saw collisions, so 0 is not for want of any");
+}
+
+#[test]
+fn fig10_does_not_depend_on_jobs_and_shards_merged_equal_one_run() {
+    let dir = scratch_dir("fig10_shards");
+    let file = fig10_file(&dir, "0.0, 6.0", 1.0, 5);
+    let mut options = quick(&dir.join("one_job"));
+    options.jobs = 1;
+    let one = fig10(&file, &options);
+    options.out = dir.join("two_jobs");
+    options.jobs = 2;
+    let two = fig10(&file, &options);
+    assert_eq!(outcomes(&one), outcomes(&two));
+    let mut parts = Vec::new();
+    for k in 1..=3 {
+        options.out = dir.join(format!("shard{k}"));
+        options.shard = Shard { k, n: 3 };
+        fig10(&file, &options);
+        parts.push(options.out.clone());
+    }
+    experiments::fig10::merge(&parts, &dir.join("merged")).unwrap();
+    let merged = table(&dir.join("merged/fig10.csv"));
+    assert_eq!(outcomes(&merged), outcomes(&one));
+    // The merged rows are the shards' rows, byte for byte (wall times included).
+    let mut from_parts: Vec<Vec<String>> = parts
+        .iter()
+        .flat_map(|p| table(&p.join("fig10.csv")).split_off(1))
+        .collect();
+    from_parts.sort_by(|a, b| {
+        (a[0].parse::<f32>().unwrap(), a[1].parse::<u32>().unwrap())
+            .partial_cmp(&(b[0].parse::<f32>().unwrap(), b[1].parse::<u32>().unwrap()))
+            .unwrap()
+    });
+    assert_eq!(merged[1..], from_parts[..]);
+    // Overlapping parts are refused.
+    let err = experiments::fig10::merge(&[parts[0].clone(), parts[0].clone()], &dir.join("bad")).unwrap_err();
+    assert!(err.contains("overlap"), "{err}");
+}
+
+#[test]
+fn an_interrupted_fig10_resumes_without_redoing_finished_trials() {
+    let dir = scratch_dir("fig10_resume");
+    let file = fig10_file(&dir, "0.0, 6.0", 1.0, 4);
+    let options = quick(&dir.join("out"));
+    let whole = fig10(&file, &options);
+    // As if stopped after trials 0 and 2: their rows in the journal, nothing else.
+    let keep: Vec<String> = std::fs::read_to_string(options.out.join("fig10.csv"))
+        .unwrap()
+        .lines()
+        .enumerate()
+        .filter(|(i, l)| *i == 0 || [",0,", ",2,"].iter().any(|t| l.contains(t)))
+        .map(|(_, l)| l.to_owned())
+        .collect();
+    std::fs::remove_file(options.out.join("fig10.csv")).unwrap();
+    std::fs::write(options.out.join("fig10.partial.csv"), keep.join("\n") + "\n").unwrap();
+    let resumed = fig10(&file, &options);
+    assert_eq!(outcomes(&resumed), outcomes(&whole));
+    // The finished trials were not run again: their wall times are the first run's.
+    for (a, b) in whole.iter().zip(&resumed) {
+        if a[1] == "0" || a[1] == "2" {
+            assert_eq!(a, b);
+        }
+    }
+    assert!(!options.out.join("fig10.partial.csv").exists());
+}
+
+#[test]
+fn a_broken_experiment_file_is_refused_with_the_file_and_the_field() {
+    let dir = scratch_dir("experiment_bad");
+    let file = dir.join("fig10.ron");
+    let good = "(radii_m: [1.0], rules: \"rules/puck-only.ron\", seconds: 1.0, trials: 1, first_seed: 1)";
+    let bad = "(radii_m: [], rules: \"rules/puck-only.ron\", seconds: -1.0, trials: 0, first_seed: 1)";
+    std::fs::write(&file, format!("(full: {good}, quick: {bad})")).unwrap();
+    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir)).unwrap_err();
+    for field in ["`quick.radii_m`", "`quick.seconds`", "`quick.trials`"] {
+        assert!(err.contains(field) && err.contains("fig10.ron"), "{field}: {err}");
+    }
+    std::fs::write(&file, format!("(full: {good}, quick: (radii_m: [1.0]))")).unwrap();
+    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir)).unwrap_err();
+    assert!(err.contains("fig10.ron") && err.contains("quick"), "{err}");
+}

@@ -149,7 +149,7 @@ fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restar
     });
     let problem = app.world().resource::<Problems>().0.values().next().unwrap().clone();
     assert!(
-        problem.contains("puck.speed_m_per_s") && problem.contains("greater than 0"),
+        problem.contains("puck.speed_m_per_s") && problem.contains("between 0.01 and 50 m/s, got -5"),
         "{problem}"
     );
     let before = seconds(&mut app);

@@ -6,15 +6,18 @@ mod cli;
 mod court;
 mod determinism;
 mod experiments;
+mod fuzz;
 mod gait;
 #[cfg(feature = "game")]
 mod game;
 mod kinds;
 mod outcome;
 mod player;
+mod pops;
 mod restart;
 mod rigid;
 mod schedule;
 mod steering;
 mod support;
 mod switching;
+mod ticks;

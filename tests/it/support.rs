@@ -44,3 +44,19 @@ pub fn scratch_dir(name: &str) -> PathBuf {
 pub fn vec2_in_court(p: Vec2, half: Vec2) -> bool {
     p.x.abs() <= half.x && p.y.abs() <= half.y
 }
+
+/// The shipped kinds and arena in a scene set here: `groups` of (kind, count) under `policy`,
+/// seed 7, so that tests do not move when `default.ron` is retuned.
+pub fn scene(groups: &[(&str, u32)], policy: simlod::lod::LevelPolicy) -> SimConfig {
+    let mut config = default_config();
+    config.scenario.seed = 7;
+    config.scenario.creatures = groups
+        .iter()
+        .map(|&(kind, count)| simlod::config::CreatureGroup {
+            kind: kind.to_owned(),
+            count,
+        })
+        .collect();
+    config.scenario.level_policy = policy;
+    config
+}

@@ -11,7 +11,7 @@ use simlod::config::SimConfig;
 use simlod::creature::{Creature, PlanarState};
 use simlod::gait::GaitPose;
 use simlod::headless::HeadlessSim;
-use simlod::lod::{LevelPolicy, LevelSwitched, Lod};
+use simlod::lod::{Drawn, LevelPolicy, LevelSwitched, Lod};
 use simlod::models::rigid::RigidPart;
 use simlod::outcome::CollisionRecord;
 
@@ -67,7 +67,8 @@ fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>,
 
 /// Height of the lowest foot's centre above the ground in a pose, the hips at `hips`.
 fn foot_height(pose: &GaitPose, hips: &[Vec3]) -> f32 {
-    pose.hips_and_feet(Vec2::ZERO, Vec2::X, hips)
+    Drawn::of(&PlanarState::default(), pose)
+        .hips_and_feet(hips)
         .map(|(_, foot)| foot.y)
         .fold(f32::INFINITY, f32::min)
 }

@@ -1,0 +1,459 @@
+//! Figure 10: what the levels change. For each puck radius, trials of a game from their own
+//! initial conditions (their own seeds) under the influence policy, each beside the identical
+//! trial all rigid; the measure is the paper's, the creatures that collided with the puck or a
+//! wall. Trials are independent: they run on `--jobs` threads, split into `--shard`s, and an
+//! interrupted run resumes from `fig10.partial.csv` without redoing finished trials.
+
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+use super::plot::{self, Mark, Panel, Series};
+use super::{ExperimentRecord, Options, command, load_settings, run_parallel, trials};
+use crate::config::{LevelRules, SimConfig, Validate, Validator, load_file};
+use crate::headless;
+use crate::lod::{LevelPolicy, Lod};
+
+/// `assets/experiments/fig10.ron`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fig10Settings {
+    /// The puck's radii of influence.
+    pub radii_m: Vec<f32>,
+    /// The level rules the trials run under (a file under the assets folder), with the
+    /// influence policy.
+    pub rules: String,
+    /// Length of each trial.
+    pub seconds: f32,
+    pub trials: u32,
+    /// Trial `i` runs with seed `first_seed + i`.
+    pub first_seed: u64,
+}
+
+impl Validate for Fig10Settings {
+    fn validate(&self, v: &mut Validator) {
+        v.require(!self.radii_m.is_empty(), "radii_m", "must list at least one radius");
+        for (i, r) in self.radii_m.iter().enumerate() {
+            v.within(&format!("radii_m[{i}]"), *r, 0.0, 1e4);
+        }
+        v.require(
+            !self.rules.is_empty() && !self.rules.contains([',', '"', '\n']),
+            "rules",
+            "must name a rules file (without commas or quotes)",
+        );
+        v.within("seconds", self.seconds, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.require(self.trials >= 1, "trials", "must be at least 1");
+    }
+}
+
+const HEADER: &str = "puck_radius_m,trial,seed,seconds,rules,collided,collided_all_rigid,difference,falls,falls_all_rigid,mean_rigid,wall_s,wall_s_all_rigid";
+
+/// One trial at one radius, beside the identical trial all rigid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub puck_radius_m: f32,
+    pub trial: u32,
+    pub seed: u64,
+    pub seconds: f32,
+    pub rules: String,
+    pub collided: u64,
+    pub collided_all_rigid: u64,
+    pub falls: u64,
+    pub falls_all_rigid: u64,
+    pub mean_rigid: f64,
+    pub wall_s: f64,
+    pub wall_s_all_rigid: f64,
+}
+
+impl Row {
+    pub fn difference(&self) -> i64 {
+        self.collided as i64 - self.collided_all_rigid as i64
+    }
+
+    fn to_csv(&self) -> String {
+        format!(
+            "{},{},{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4}",
+            self.puck_radius_m,
+            self.trial,
+            self.seed,
+            self.seconds,
+            self.rules,
+            self.collided,
+            self.collided_all_rigid,
+            self.difference(),
+            self.falls,
+            self.falls_all_rigid,
+            self.mean_rigid,
+            self.wall_s,
+            self.wall_s_all_rigid
+        )
+    }
+
+    fn parse(line: &str) -> Option<Row> {
+        let f: Vec<&str> = line.split(',').collect();
+        if f.len() != HEADER.split(',').count() {
+            return None;
+        }
+        Some(Row {
+            puck_radius_m: f[0].parse().ok()?,
+            trial: f[1].parse().ok()?,
+            seed: f[2].parse().ok()?,
+            seconds: f[3].parse().ok()?,
+            rules: f[4].to_owned(),
+            collided: f[5].parse().ok()?,
+            collided_all_rigid: f[6].parse().ok()?,
+            falls: f[8].parse().ok()?,
+            falls_all_rigid: f[9].parse().ok()?,
+            mean_rigid: f[10].parse().ok()?,
+            wall_s: f[11].parse().ok()?,
+            wall_s_all_rigid: f[12].parse().ok()?,
+        })
+    }
+
+    /// Same trial of the same plan (the wall times aside).
+    fn key(&self) -> (u32, u64, u32, u32, String) {
+        (
+            self.puck_radius_m.to_bits(),
+            self.seed,
+            self.trial,
+            self.seconds.to_bits(),
+            self.rules.clone(),
+        )
+    }
+}
+
+/// The rows of a `fig10.csv` (or a partial one); `None` if the file does not exist.
+pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, String> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(None);
+    };
+    let mut lines = text.lines();
+    if lines.next() != Some(HEADER) {
+        return Err(format!(
+            "{}: not a fig10 table (its first line is not `{HEADER}`)",
+            path.display()
+        ));
+    }
+    lines
+        .enumerate()
+        .filter(|(_, l)| !l.is_empty())
+        .map(|(i, l)| Row::parse(l).ok_or_else(|| format!("{}: line {}: not a fig10 row: {l}", path.display(), i + 2)))
+        .collect::<Result<Vec<_>, _>>()
+        .map(Some)
+}
+
+/// One trial: the all-rigid run, then the influence policy at every radius, same seed.
+fn run_trial(config: &SimConfig, rules: &LevelRules, s: &Fig10Settings, trial: u32) -> Vec<Row> {
+    let seed = s.first_seed + u64::from(trial);
+    let seconds = f64::from(s.seconds);
+    let mut c = config.clone();
+    c.rules = rules.clone();
+    c.scenario.seed = seed;
+    c.scenario.level_policy = LevelPolicy::AllRigid;
+    let rigid = headless::run(c.clone(), seconds);
+    c.scenario.level_policy = LevelPolicy::Influence;
+    s.radii_m
+        .iter()
+        .map(|&r| {
+            c.rules.influence.puck_radius_m = r;
+            let run = headless::run(c.clone(), seconds);
+            Row {
+                puck_radius_m: r,
+                trial,
+                seed,
+                seconds: s.seconds,
+                rules: s.rules.clone(),
+                collided: run.creatures_collided,
+                collided_all_rigid: rigid.creatures_collided,
+                falls: run.falls,
+                falls_all_rigid: rigid.falls,
+                mean_rigid: run.levels_mean[Lod::Rigid],
+                wall_s: run.wall_seconds,
+                wall_s_all_rigid: rigid.wall_seconds,
+            }
+        })
+        .collect()
+}
+
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+    let s: Fig10Settings = load_settings(file, options)?;
+    let rules: LevelRules = load_file(&options.assets.join(&s.rules))
+        .map_err(|e| format!("{e} (named by {}: field `rules`)", file.display()))?;
+    let s = Fig10Settings {
+        trials: trials(options, s.trials),
+        ..s
+    };
+    let out = &options.out;
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let (done_path, partial_path) = (out.join("fig10.csv"), out.join("fig10.partial.csv"));
+    // What an earlier run of the same plan finished: whole trials only.
+    let mut earlier = read_rows(&done_path)?.unwrap_or_default();
+    earlier.extend(read_rows(&partial_path)?.unwrap_or_default());
+    let mine: Vec<u32> = (0..s.trials).filter(|&t| options.shard.owns(t)).collect();
+    let plan = &s;
+    let wanted: BTreeSet<_> = mine
+        .iter()
+        .flat_map(|&t| {
+            plan.radii_m.iter().map(move |r| {
+                let seed = plan.first_seed + u64::from(t);
+                (r.to_bits(), seed, t, plan.seconds.to_bits(), plan.rules.clone())
+            })
+        })
+        .collect();
+    let mut by_trial: BTreeMap<u32, Vec<Row>> = BTreeMap::new();
+    let mut seen = BTreeSet::new();
+    for row in earlier {
+        if wanted.contains(&row.key()) && seen.insert(row.key()) {
+            by_trial.entry(row.trial).or_default().push(row);
+        }
+    }
+    by_trial.retain(|_, rows| rows.len() == s.radii_m.len());
+    let todo: Vec<u32> = mine.iter().copied().filter(|t| !by_trial.contains_key(t)).collect();
+    if todo.len() < mine.len() {
+        eprintln!(
+            "fig10: resuming: {} of {} trials already done in {}",
+            mine.len() - todo.len(),
+            mine.len(),
+            out.display()
+        );
+    }
+    // The journal: every finished trial's rows, appended as it finishes.
+    let mut journal_text = format!("{HEADER}\n");
+    for row in by_trial.values().flatten() {
+        journal_text += &(row.to_csv() + "\n");
+    }
+    std::fs::write(&partial_path, journal_text).map_err(|e| format!("cannot write {}: {e}", partial_path.display()))?;
+    let mut journal = std::fs::OpenOptions::new()
+        .append(true)
+        .open(&partial_path)
+        .map_err(|e| format!("cannot open {}: {e}", partial_path.display()))?;
+    let mut progress = super::Progress::new("fig10 trials", todo.len() as u64);
+    let mut failed = None;
+    run_parallel(
+        &todo,
+        options.jobs,
+        |&t| run_trial(config, &rules, &s, t),
+        |&t, rows| {
+            let text: String = rows.iter().map(|r| r.to_csv() + "\n").collect();
+            if let Err(e) = journal.write_all(text.as_bytes()).and_then(|()| journal.flush()) {
+                failed = Some(format!("cannot write {}: {e}", partial_path.display()));
+            }
+            by_trial.insert(t, rows);
+            progress.inc();
+        },
+    );
+    drop(progress);
+    if let Some(e) = failed {
+        return Err(e);
+    }
+    let rows: Vec<Row> = by_trial.into_values().flatten().collect();
+    let text = finish(
+        rows,
+        out,
+        &command("fig10", options),
+        &options.scenario,
+        &options.assets,
+    )?;
+    let _ = std::fs::remove_file(&partial_path);
+    Ok(text)
+}
+
+/// `simlod experiment merge DIR... --out OUT`: the shards' rows as one run's.
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
+    let mut rows = Vec::new();
+    let mut seen = BTreeSet::new();
+    let mut origin: Option<(PathBuf, PathBuf)> = None;
+    for dir in dirs {
+        let path = dir.join("fig10.csv");
+        let part = read_rows(&path)?.ok_or_else(|| {
+            format!(
+                "{}: no such file (is {} a finished fig10 shard?)",
+                path.display(),
+                dir.display()
+            )
+        })?;
+        for row in part {
+            if !seen.insert(row.key()) {
+                return Err(format!(
+                    "{}: trial {} (seed {}) at {} m is also in another part: the parts overlap",
+                    path.display(),
+                    row.trial,
+                    row.seed,
+                    row.puck_radius_m
+                ));
+            }
+            rows.push(row);
+        }
+        if origin.is_none()
+            && let Ok(json) = std::fs::read_to_string(dir.join("fig10.json"))
+            && let Ok(record) = serde_json::from_str::<ExperimentRecord>(&json)
+        {
+            let text = |k: &str| record.summary[k].as_str().map(PathBuf::from);
+            origin = text("scenario").zip(text("assets"));
+        }
+    }
+    let (scenario, assets) = origin.unwrap_or_else(|| ("assets/scenarios/default.ron".into(), "assets".into()));
+    let dirs: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
+    let command = format!("simlod experiment merge {} --out {}", dirs.join(" "), out.display());
+    finish(rows, out, &command, &scenario, &assets)
+}
+
+/// Figures per radius.
+#[derive(Clone, Debug, Serialize)]
+struct RadiusSummary {
+    puck_radius_m: f32,
+    trials: usize,
+    mean_difference: f64,
+    variance_difference: f64,
+    mean_collided: f64,
+    mean_collided_all_rigid: f64,
+    mean_falls: f64,
+    mean_falls_all_rigid: f64,
+    mean_rigid: f64,
+    wall_s: f64,
+    wall_s_all_rigid: f64,
+    /// All-rigid wall time over this radius's.
+    speedup: f64,
+}
+
+fn summarise(rows: &[Row]) -> Vec<RadiusSummary> {
+    let mut radii: Vec<f32> = rows.iter().map(|r| r.puck_radius_m).collect();
+    radii.sort_by(f32::total_cmp);
+    radii.dedup();
+    radii
+        .into_iter()
+        .map(|radius| {
+            let at: Vec<&Row> = rows.iter().filter(|r| r.puck_radius_m == radius).collect();
+            let n = at.len() as f64;
+            let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
+            let mean_difference = mean(&|r| r.difference() as f64);
+            let variance_difference = if at.len() > 1 {
+                at.iter()
+                    .map(|r| (r.difference() as f64 - mean_difference).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0)
+            } else {
+                0.0
+            };
+            let wall_s = at.iter().map(|r| r.wall_s).sum::<f64>();
+            let wall_s_all_rigid = at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>();
+            RadiusSummary {
+                puck_radius_m: radius,
+                trials: at.len(),
+                mean_difference,
+                variance_difference,
+                mean_collided: mean(&|r| r.collided as f64),
+                mean_collided_all_rigid: mean(&|r| r.collided_all_rigid as f64),
+                mean_falls: mean(&|r| r.falls as f64),
+                mean_falls_all_rigid: mean(&|r| r.falls_all_rigid as f64),
+                mean_rigid: mean(&|r| r.mean_rigid),
+                wall_s,
+                wall_s_all_rigid,
+                speedup: wall_s_all_rigid / wall_s,
+            }
+        })
+        .collect()
+}
+
+/// Writes the table, the plots, the summary and the report from all the trials' rows.
+fn finish(mut rows: Vec<Row>, out: &Path, command: &str, scenario: &Path, assets: &Path) -> Result<String, String> {
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    rows.sort_by(|a, b| a.puck_radius_m.total_cmp(&b.puck_radius_m).then(a.trial.cmp(&b.trial)));
+    let mut csv = format!("{HEADER}\n");
+    for row in &rows {
+        csv += &(row.to_csv() + "\n");
+    }
+    let per_radius = summarise(&rows);
+    let difference: Vec<(f64, f64)> = per_radius
+        .iter()
+        .map(|p| (f64::from(p.puck_radius_m), p.mean_difference))
+        .collect();
+    let mut with_bars = Series::new(
+        "influence minus all rigid (mean, bars: 1 s.d.)",
+        difference.clone(),
+        Mark::Line,
+        0,
+    );
+    with_bars.errors = Some(per_radius.iter().map(|p| p.variance_difference.sqrt()).collect());
+    let zero = Series::new(
+        "no change",
+        difference.iter().map(|&(x, _)| (x, 0.0)).collect(),
+        Mark::Dashed,
+        5,
+    );
+    let trade: Vec<(f64, f64)> = per_radius.iter().map(|p| (p.mean_difference, p.speedup)).collect();
+    let n_trials = per_radius.iter().map(|p| p.trials).max().unwrap_or(0);
+    let seconds = rows.first().map_or(0.0, |r| r.seconds);
+    plot::draw(
+        &out.join("fig10.png"),
+        1400,
+        600,
+        &[
+            Panel {
+                title: format!(
+                    "Figure 10: change in creatures that hit the puck or a wall ({n_trials} trials of {seconds} s)"
+                ),
+                x_label: "the puck's radius of influence (m)".into(),
+                y_label: "change in creatures collided".into(),
+                series: vec![with_bars, zero],
+                ..Panel::default()
+            },
+            Panel {
+                title: "the trade-off: speed against outcome".into(),
+                x_label: "change in creatures collided (mean)".into(),
+                y_label: "speed-up over all rigid (wall time)".into(),
+                series: vec![Series::new("one point per radius", trade.clone(), Mark::Line, 1)],
+                notes: per_radius
+                    .iter()
+                    .map(|p| (p.mean_difference, p.speedup, format!("  {} m", p.puck_radius_m)))
+                    .collect(),
+                ..Panel::default()
+            },
+        ],
+    )?;
+    let mut report = format!(
+        "For each puck radius, {n_trials} trials of {seconds} s, each from its own seed, under the influence policy (rules `{}`), \
+         each beside the identical trial all rigid; the measure is the paper's, the creatures that collided with the puck or a wall. \
+         The difference is influence minus all rigid. Trials ran in parallel, each simulation on one thread; wall times are per trial.\n\n\
+         | radius (m) | trials | difference: mean | variance | collided | collided all rigid | falls | falls all rigid | rigid creatures (mean) | speed-up |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+        rows.first().map_or("", |r| r.rules.as_str())
+    );
+    for p in &per_radius {
+        let _ = writeln!(
+            report,
+            "| {} | {} | {:+.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
+            p.puck_radius_m,
+            p.trials,
+            p.mean_difference,
+            p.variance_difference,
+            p.mean_collided,
+            p.mean_collided_all_rigid,
+            p.mean_falls,
+            p.mean_falls_all_rigid,
+            p.mean_rigid,
+            p.speedup
+        );
+    }
+    let _ = write!(
+        report,
+        "\nThe paper finds the difference flat from 15 to 8 m and falling below 8 m (the hybrid, more agile, collides less). \
+         Any row reruns alone: `simlod run --scenario {sc} --rules {rules} --seed SEED --policy influence --puck-radius R --seconds {seconds} --json` \
+         prints `creatures_collided` (the row's `collided`) and `falls`; the same with `--policy all-rigid` the all-rigid ones.\n",
+        sc = scenario.display(),
+        rules = assets.join(rows.first().map_or("", |r| r.rules.as_str())).display(),
+    );
+    ExperimentRecord {
+        experiment: "fig10".into(),
+        command: command.to_owned(),
+        summary: serde_json::json!({
+            "per_radius": per_radius,
+            "scenario": scenario.display().to_string(),
+            "assets": assets.display().to_string(),
+        }),
+        report,
+    }
+    .finish(out, &csv)
+}

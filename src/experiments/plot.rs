@@ -1,0 +1,213 @@
+//! The experiments' plots: PNG files drawn with plotters' bitmap backend, text in the DejaVu
+//! Sans font shipped in `assets/fonts` (no system fonts, no system packages).
+
+use plotters::prelude::*;
+use plotters::style::{FontStyle, register_font};
+use std::path::Path;
+use std::sync::Once;
+
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+/// How a series is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Mark {
+    /// A line through the points, with a dot at each.
+    Line,
+    /// A dashed line.
+    Dashed,
+    /// Points only (the paper's numbers).
+    Points,
+}
+
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+    /// Half-heights of error bars, one per point.
+    pub errors: Option<Vec<f64>>,
+    pub mark: Mark,
+    /// Index into the palette.
+    pub colour: usize,
+}
+
+impl Series {
+    pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, mark: Mark, colour: usize) -> Self {
+        Self {
+            label: label.into(),
+            points,
+            errors: None,
+            mark,
+            colour,
+        }
+    }
+}
+
+/// One chart: axes with their units, series, a legend.
+#[derive(Clone, Debug, Default)]
+pub struct Panel {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub log_y: bool,
+    /// Names for whole-number x positions (a categorical axis), if any.
+    pub x_names: Vec<String>,
+    pub series: Vec<Series>,
+    /// Labels written beside points: (x, y, text).
+    pub notes: Vec<(f64, f64, String)>,
+}
+
+const PALETTE: [RGBColor; 6] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(90, 90, 90),
+];
+
+fn register() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        register_font("sans-serif", FontStyle::Normal, FONT)
+            .unwrap_or_else(|_| panic!("the shipped font is a valid TrueType font"));
+    });
+}
+
+/// The range of the values, padded; on a log axis, whole decades around them.
+fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && (!log || *v > 0.0))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return if log { (0.1, 10.0) } else { (0.0, 1.0) };
+    }
+    if log {
+        (
+            10f64.powf(lo.log10().floor()),
+            10f64.powf(hi.log10().ceil().max(lo.log10().floor() + 1.0)),
+        )
+    } else {
+        let pad = ((hi - lo) * 0.08).max(hi.abs().max(1.0) * 0.05);
+        (lo - pad, hi + pad)
+    }
+}
+
+/// A tick label: at most three decimals, no trailing zeros.
+fn tidy(x: f64) -> String {
+    let s = format!("{x:.3}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+/// Draws `panels` side by side into a PNG of `width` by `height` pixels.
+pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel]) -> Result<(), String> {
+    register();
+    let fail = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
+    let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| fail(&e))?;
+    for (area, panel) in root.split_evenly((1, panels.len().max(1))).iter().zip(panels) {
+        draw_panel(area, panel).map_err(|e| fail(&e))?;
+    }
+    root.present().map_err(|e| fail(&e))
+}
+
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> {
+    let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
+    let (mut x0, mut x1) = range(xs, false);
+    if !p.x_names.is_empty() {
+        (x0, x1) = (-0.5, p.x_names.len() as f64 - 0.5);
+    }
+    let ys = p.series.iter().flat_map(|s| {
+        s.points.iter().enumerate().flat_map(move |(i, q)| {
+            let e = s.errors.as_ref().map_or(0.0, |e| e[i]);
+            [q.1 - e, q.1 + e]
+        })
+    });
+    let (y0, y1) = range(ys, p.log_y);
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(&p.title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70);
+    let names = p.x_names.clone();
+    let x_fmt = move |x: &f64| {
+        if names.is_empty() {
+            tidy(*x)
+        } else if (x - x.round()).abs() < 1e-6 {
+            names.get(x.round() as usize).cloned().unwrap_or_default()
+        } else {
+            String::new()
+        }
+    };
+    macro_rules! body {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            let mut mesh = chart.configure_mesh();
+            mesh.x_desc(&p.x_label)
+                .y_desc(&p.y_label)
+                .label_style(("sans-serif", 14))
+                .axis_desc_style(("sans-serif", 16))
+                .x_label_formatter(&x_fmt)
+                .y_label_formatter(&|y: &f64| tidy(*y));
+            if !p.x_names.is_empty() {
+                mesh.x_labels(p.x_names.len() * 2 + 1);
+            }
+            mesh.draw()?;
+            for s in &p.series {
+                let colour = PALETTE[s.colour % PALETTE.len()];
+                let style = ShapeStyle::from(&colour).stroke_width(2);
+                let points = s.points.clone();
+                let anno = match s.mark {
+                    Mark::Line => chart.draw_series(LineSeries::new(points.clone(), style))?,
+                    Mark::Dashed => chart.draw_series(DashedLineSeries::new(points.clone(), 8, 5, style))?,
+                    Mark::Points => {
+                        chart.draw_series(points.iter().map(|&q| TriangleMarker::new(q, 7, colour.filled())))?
+                    }
+                };
+                let anno = anno.label(&s.label);
+                match s.mark {
+                    Mark::Points => anno.legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, colour.filled())),
+                    Mark::Line => anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style)),
+                    Mark::Dashed => anno.legend(move |(x, y)| {
+                        EmptyElement::at((x, y))
+                            + PathElement::new(vec![(0, 0), (7, 0)], style)
+                            + PathElement::new(vec![(13, 0), (20, 0)], style)
+                    }),
+                };
+                if s.mark != Mark::Points {
+                    chart.draw_series(points.iter().map(|&q| Circle::new(q, 3, colour.filled())))?;
+                }
+                if let Some(errors) = &s.errors {
+                    chart.draw_series(
+                        points.iter().zip(errors).map(|(&(x, y), &e)| {
+                            ErrorBar::new_vertical(x, y - e, y, y + e, colour.stroke_width(2), 10)
+                        }),
+                    )?;
+                }
+            }
+            for (x, y, text) in &p.notes {
+                chart.draw_series(std::iter::once(Text::new(
+                    text.clone(),
+                    (*x, *y),
+                    ("sans-serif", 13).into_font(),
+                )))?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 14))
+                .position(SeriesLabelPosition::UpperRight)
+                .draw()?;
+        }};
+    }
+    if p.log_y {
+        body!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?);
+    } else {
+        body!(builder.build_cartesian_2d(x0..x1, y0..y1)?);
+    }
+    Ok(())
+}

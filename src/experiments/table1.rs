@@ -1,0 +1,187 @@
+//! Table 1: the cost of one creature for 1/30 s of motion at each level. Measured as the
+//! paper does, the model and its low-level control alone (no steering, no collisions, no
+//! rendering: every creature runs at a set speed in its own direction), and, in a second
+//! column, the whole per-creature cost of a game (steering, level rules and collisions).
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plot::{self, Mark, Panel, Series};
+use super::{ExperimentRecord, Options, check_kind, command, hold_levels, load_settings, median_of, only_kind, trials};
+use crate::SimStage;
+use crate::bench::{median_frame_seconds, median_frame_seconds_of, scaled};
+use crate::config::{SimConfig, Validate, Validator};
+use crate::creature::{DesiredVelocity, PlanarState};
+use crate::headless::HeadlessSim;
+use crate::lod::{LevelPolicy, Lod};
+
+/// The paper's Table 1 (SGI R10000): ms per creature per 1/30 s, point mass, hybrid, rigid.
+pub const PAPER_MS: [f64; 3] = [0.0025, 0.024, 2.4];
+
+/// `assets/experiments/table1.ron` (its `full` and `quick` sections).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Table1Settings {
+    /// The creature kind measured (it needs a rigid model and a gait table).
+    pub creature: String,
+    /// Creatures in the measured world, at each level: point mass, hybrid, rigid.
+    pub creatures: (u32, u32, u32),
+    /// Speed every creature runs at while its model alone is measured.
+    pub model_speed_m_per_s: f32,
+    pub warmup_frames: u32,
+    /// Frames timed per run; a run's figure is its median frame.
+    pub frames: u32,
+    /// Fresh runs per level and measure; the table has their median.
+    pub trials: u32,
+}
+
+impl Validate for Table1Settings {
+    fn validate(&self, v: &mut Validator) {
+        v.require(!self.creature.is_empty(), "creature", "must name a creature kind");
+        for (i, n) in [self.creatures.0, self.creatures.1, self.creatures.2]
+            .into_iter()
+            .enumerate()
+        {
+            v.require(
+                (1..=100_000).contains(&n),
+                &format!("creatures.{i}"),
+                format!("must be between 1 and 100000, got {n}"),
+            );
+        }
+        v.within("model_speed_m_per_s", self.model_speed_m_per_s, 0.0, 10.0);
+        v.require(self.frames >= 1, "frames", "must be at least 1");
+        v.require(self.trials >= 1, "trials", "must be at least 1");
+    }
+}
+
+const LEVELS: [(Lod, LevelPolicy); 3] = [
+    (Lod::PointMass, LevelPolicy::AllPointMass),
+    (Lod::Hybrid, LevelPolicy::AllHybrid),
+    (Lod::Rigid, LevelPolicy::AllRigid),
+];
+
+/// Median frame of the models alone: levels held, no sensing, steering or collisions;
+/// every creature runs at `speed` the way it faces.
+fn model_frame_seconds(config: SimConfig, speed: f32, warmup: usize, frames: usize) -> f64 {
+    let mut sim = HeadlessSim::new(config);
+    hold_levels(&mut sim, &[SimStage::Sense, SimStage::Steer, SimStage::Observe]);
+    let world = sim.app.world_mut();
+    for (state, mut desired) in world.query::<(&PlanarState, &mut DesiredVelocity)>().iter_mut(world) {
+        desired.0 = state.heading * speed;
+    }
+    median_frame_seconds_of(&mut sim, warmup, frames)
+}
+
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+    let s: Table1Settings = load_settings(file, options)?;
+    check_kind(config, file, "creature", &s.creature)?;
+    let base = only_kind(config, &s.creature);
+    let n_trials = trials(options, s.trials);
+    let (warmup, frames) = (s.warmup_frames as usize, s.frames as usize);
+    let counts = [s.creatures.0, s.creatures.1, s.creatures.2];
+    let mut csv = String::from("level,measure,trial,creatures,frame_ms_median,ms_per_creature_per_frame\n");
+    let mut progress = super::Progress::new("table1", 3 * 2 * u64::from(n_trials));
+    // [level][model, game] ms per creature per frame, the median over trials.
+    let mut ms = [[0.0; 2]; 3];
+    for (i, (level, policy)) in LEVELS.into_iter().enumerate() {
+        let n = counts[i];
+        let world = scaled(&base, n, policy);
+        for (m, measure) in ["model", "game"].into_iter().enumerate() {
+            let mut per_creature = Vec::new();
+            for trial in 0..n_trials {
+                let frame_s = if m == 0 {
+                    model_frame_seconds(world.clone(), s.model_speed_m_per_s, warmup, frames)
+                } else {
+                    median_frame_seconds(world.clone(), warmup, frames)
+                };
+                let each = frame_s * 1e3 / f64::from(n);
+                let _ = writeln!(
+                    csv,
+                    "{},{measure},{trial},{n},{:.6},{each:.8}",
+                    level.name(),
+                    frame_s * 1e3
+                );
+                per_creature.push(each);
+                progress.inc();
+            }
+            ms[i][m] = median_of(per_creature);
+        }
+    }
+    drop(progress);
+    let names = ["point mass", "hybrid", "rigid"];
+    let series = |m: usize, label: &str, mark, colour| {
+        Series::new(label, (0..3).map(|i| (i as f64, ms[i][m])).collect(), mark, colour)
+    };
+    plot::draw(
+        &options.out.join("table1.png"),
+        900,
+        600,
+        &[Panel {
+            title: "Table 1: cost per creature per 1/30 s of motion".into(),
+            x_label: "level of detail".into(),
+            y_label: "ms per creature per 1/30 s (log)".into(),
+            log_y: true,
+            x_names: names.iter().map(|s| s.to_string()).collect(),
+            series: vec![
+                series(0, "simlod: model and control alone", Mark::Line, 0),
+                series(1, "simlod: whole game (steering, collisions)", Mark::Dashed, 2),
+                Series::new(
+                    "paper (SGI R10000, 1997)",
+                    PAPER_MS.iter().enumerate().map(|(i, &v)| (i as f64, v)).collect(),
+                    Mark::Points,
+                    1,
+                ),
+            ],
+            notes: vec![],
+        }],
+    )?;
+    let ratio = |m: usize, cheap: usize| ms[2][m] / ms[cheap][m];
+    let mut report = format!(
+        "The cost of one creature for 1/30 s of motion, the median over {n_trials} fresh runs of each run's median of {frames} frames \
+         (after {warmup} warm-up frames), one measurement at a time in one process, {} hoppers at the point-mass and hybrid levels and {} rigid. \
+         *Model alone* is the paper's measure (simulation and low-level control; no steering, collisions or rendering); *game* adds steering, the level rules and collisions.\n\n\
+         | level | paper (ms) | simlod, model alone (ms) | simlod, game (ms) |\n|---|---|---|---|\n",
+        counts[0], counts[2]
+    );
+    for i in 0..3 {
+        let _ = writeln!(
+            report,
+            "| {} | {} | {:.5} | {:.5} |",
+            names[i], PAPER_MS[i], ms[i][0], ms[i][1]
+        );
+    }
+    let _ = write!(
+        report,
+        "\nA rigid creature costs {:.0} times a hybrid one and {:.0} times a point mass (model alone; in the game {:.0} and {:.0}); \
+         the paper: {:.0} and {:.0}. Our rigid level is {:.1} times cheaper than the paper's on its 1997 workstation, our hybrid {:.0} times.\n",
+        ratio(0, 1),
+        ratio(0, 0),
+        ratio(1, 1),
+        ratio(1, 0),
+        PAPER_MS[2] / PAPER_MS[1],
+        PAPER_MS[2] / PAPER_MS[0],
+        PAPER_MS[2] / ms[2][0],
+        PAPER_MS[1] / ms[1][0],
+    );
+    let summary = serde_json::json!({
+        "ms_per_creature_per_frame": {
+            "model": { "point_mass": ms[0][0], "hybrid": ms[1][0], "rigid": ms[2][0] },
+            "game": { "point_mass": ms[0][1], "hybrid": ms[1][1], "rigid": ms[2][1] },
+            "paper": { "point_mass": PAPER_MS[0], "hybrid": PAPER_MS[1], "rigid": PAPER_MS[2] },
+        },
+        "ratio": {
+            "rigid/hybrid": ratio(0, 1), "rigid/point_mass": ratio(0, 0),
+            "game rigid/hybrid": ratio(1, 1), "game rigid/point_mass": ratio(1, 0),
+        },
+        "creatures": counts, "trials": n_trials, "frames": frames,
+    });
+    ExperimentRecord {
+        experiment: "table1".into(),
+        command: command("table1", options),
+        summary,
+        report,
+    }
+    .finish(&options.out, &csv)
+}
