@@ -15,7 +15,7 @@ use std::fmt::Write as _;
 use super::{GaitPose, GaitRow, GaitTable, columns};
 use crate::config::SimConfig;
 use crate::creature::{DesiredVelocity, GaitPhase, PlanarState};
-use crate::experiments::{EXPERIMENT_COURT_M, lone_creature};
+use crate::experiments::{EXPERIMENT_COURT_M, lone_creature, stand};
 use crate::headless::HeadlessSim;
 use crate::lod::LevelPolicy;
 
@@ -66,10 +66,12 @@ fn runner(config: &SimConfig, kind: &str, speed: f32) -> (HeadlessSim, Entity) {
     // From near one wall toward the other: the longest straight run the court allows.
     let start = Vec2::new(10.0 - EXPERIMENT_COURT_M / 2.0, 0.0);
     let (mut sim, creature) = lone_creature(&config, kind, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
-    sim.app
-        .world_mut()
+    let world = sim.app.world_mut();
+    world
         .entity_mut(creature)
         .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+    // Facing its course from the start: the recording is of running, not of turning.
+    stand(world, creature, start, Some(Vec2::X));
     (sim, creature)
 }
 

@@ -60,10 +60,15 @@ fn switch_levels(
 ) {
     let now = clock.seconds() as f32;
     let (open, close) = config.rules.flight_window;
+    let rules_move_levels = config.scenario.level_policy.is_dynamic();
     for (entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before)) in &mut creatures {
         let kind = &kinds[creature.kind];
-        let forced =
-            lod != Lod::Rigid && record.touching.iter().any(|&t| t) && kind.best_level(Lod::Rigid) == Lod::Rigid;
+        // Under a fixed policy ("every creature at the point-mass level") a collision does not
+        // overrule it.
+        let forced = rules_move_levels
+            && lod != Lod::Rigid
+            && record.touching.iter().any(|&t| t)
+            && kind.best_level(Lod::Rigid) == Lod::Rigid;
         let target = if forced { Lod::Rigid } else { choice.wanted };
         if target == lod {
             if before.0.is_some() {

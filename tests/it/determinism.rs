@@ -34,5 +34,5 @@ fn the_rigid_level_is_deterministic_too() {
     config.scenario.level_policy = simlod::lod::LevelPolicy::AllRigid;
     let a = digest_after(config.clone(), 5.0);
     assert_eq!(a, digest_after(config, 5.0));
-    assert_eq!(a.1.levels[Lod::Rigid], 30);
+    assert_eq!(a.1.levels[Lod::Rigid], 40);
 }

@@ -192,3 +192,52 @@ fn the_pinned_scene_gives_the_same_digest_as_when_it_was_pinned() {
 }
 
 const PINNED_DIGEST: u64 = 14698065385395456291;
+
+/// The shipped scenario with the third kind, made of asset files alone.
+fn three_kinds(policy: LevelPolicy) -> SimConfig {
+    let root = assets_root();
+    let mut config = SimConfig::load(&root.join("scenarios/three-kinds.ron"), &root).expect("the shipped assets load");
+    config.scenario.level_policy = policy;
+    config
+}
+
+#[test]
+fn the_shipped_stilt_is_asset_files_alone_and_its_table_is_the_commands() {
+    // Its table is what the command writes from its file, byte for byte.
+    let mut config = three_kinds(LevelPolicy::AllRigid);
+    let stilt = config.kind_index("stilt").unwrap();
+    config.gaits[stilt] = None; // as record-gait does: never from an earlier table
+    let table = record(&config, "stilt", &RecordSettings::default()).unwrap();
+    let command = "simlod record-gait --creature assets/creatures/stilt.ron --speeds 0,1,2,3";
+    let shipped = std::fs::read_to_string(assets_root().join("gaits/stilt.ron")).unwrap();
+    assert_eq!(to_file_text(&table, command), shipped);
+
+    // Every policy moves its stilts at that level.
+    for (policy, level) in [
+        (LevelPolicy::AllPointMass, Lod::PointMass),
+        (LevelPolicy::AllHybrid, Lod::Hybrid),
+        (LevelPolicy::AllRigid, Lod::Rigid),
+    ] {
+        let mut sim = HeadlessSim::new(three_kinds(policy));
+        let stilts = |sim: &mut HeadlessSim| -> Vec<(Lod, Vec2)> {
+            let world = sim.app.world_mut();
+            world
+                .query::<(&Creature, &Lod, &PlanarState)>()
+                .iter(world)
+                .filter(|(c, _, _)| c.kind == stilt)
+                .map(|(_, l, s)| (*l, s.position))
+                .collect()
+        };
+        let before = stilts(&mut sim);
+        sim.run_for(3.0);
+        let after = stilts(&mut sim);
+        assert_eq!(after.len(), 10, "{policy:?}");
+        assert!(after.iter().all(|(l, _)| *l == level), "{policy:?}: {after:?}");
+        let moved = before
+            .iter()
+            .zip(&after)
+            .filter(|(a, b)| a.1.distance(b.1) > 0.1)
+            .count();
+        assert!(moved >= 5, "{policy:?}: {moved} of 10 stilts moved");
+    }
+}

@@ -1,5 +1,5 @@
-//! The rigid-body hopper (paper 3.1): hops, runs, turns, recovers and falls like a dynamic
-//! creature.
+//! The rigid-body hopper and biped (paper 3.1): hop or run, track speeds, turn, recover and
+//! fall like dynamic creatures. The biped runs Raibert's "one-foot" gait, its legs in turn.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
@@ -13,9 +13,15 @@ use simlod::models::rigid::{RigidBodies, RigidPart, Shove};
 
 /// One rigid hopper steered from outside at `desired`, far from the walls and the parked puck.
 pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
+    lone("hopper", desired)
+}
+
+/// One rigid creature of `kind` steered from outside at `desired`, facing it, far from the
+/// walls and the parked puck.
+pub fn lone(kind: &str, desired: Vec2) -> (HeadlessSim, Entity) {
     let (mut sim, hopper) = lone_creature(
         &default_config(),
-        "hopper",
+        kind,
         LevelPolicy::AllRigid,
         Vec2::new(-180.0, 100.0),
         420.0,
@@ -45,7 +51,7 @@ fn touchdowns(sim: &mut HeadlessSim, entity: Entity, from: f64, seconds: f64) ->
     while sim.clock().seconds() < seconds {
         sim.advance_frame();
         let t = touchdown(sim, entity);
-        assert!(!t.is_nan(), "the hopper fell at {:.2} s", sim.clock().seconds());
+        assert!(!t.is_nan(), "it fell at {:.2} s", sim.clock().seconds());
         if t != last && sim.clock().seconds() >= from {
             out.push((t, state(sim, entity).unwrap().position));
         }
@@ -54,9 +60,10 @@ fn touchdowns(sim: &mut HeadlessSim, entity: Entity, from: f64, seconds: f64) ->
     out
 }
 
-/// The hopper's whole mass, from its file.
-fn hopper_mass_kg() -> f32 {
-    let kind = &config_with_hoppers(1).kinds[0];
+/// A kind's whole mass, from its file.
+fn mass_kg(name: &str) -> f32 {
+    let config = default_config();
+    let kind = config.kinds.iter().find(|k| k.name == name).unwrap();
     kind.legs
         .iter()
         .fold(kind.body.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg)
@@ -66,23 +73,46 @@ fn falls(sim: &mut HeadlessSim) -> u64 {
     sim.summary(0.0).falls
 }
 
-#[test]
-fn hops_in_place_for_sixty_seconds_without_falling() {
-    let (mut sim, hopper) = lone_hopper(Vec2::ZERO);
-    let start = state(&mut sim, hopper).unwrap().position;
-    let hops = touchdowns(&mut sim, hopper, 0.0, 60.0);
+/// Runs `kind` in place for 60 s: no fall, about two steps a second all the while, and a
+/// drift under `max_drift_m`.
+fn runs_in_place_for_sixty_seconds(kind: &str, max_drift_m: f32) {
+    let (mut sim, creature) = lone(kind, Vec2::ZERO);
+    let start = state(&mut sim, creature).unwrap().position;
+    let hops = touchdowns(&mut sim, creature, 0.0, 60.0);
     assert_eq!(falls(&mut sim), 0);
-    // About two hops a second, all the while.
     assert!(hops.len() > 90, "{} touchdowns in 60 s", hops.len());
     assert!(hops.last().unwrap().0 > 59.0);
-    let drift = state(&mut sim, hopper).unwrap().position.distance(start);
-    assert!(drift < 0.5, "drifted {drift} m while hopping in place");
+    let drift = state(&mut sim, creature).unwrap().position.distance(start);
+    assert!(drift < max_drift_m, "drifted {drift} m while running in place");
 }
 
 #[test]
+fn hops_in_place_for_sixty_seconds_without_falling() {
+    runs_in_place_for_sixty_seconds("hopper", 0.5);
+}
+
+#[test]
+fn the_biped_runs_in_place_for_sixty_seconds_without_falling() {
+    // Its steps sway it side to side; the integral speed correction holds it near its spot.
+    runs_in_place_for_sixty_seconds("biped", BIPED_IN_PLACE_DRIFT_M);
+}
+
+const BIPED_IN_PLACE_DRIFT_M: f32 = 3.0;
+
+#[test]
 fn tracks_commanded_speeds_of_zero_to_three_metres_a_second() {
-    for speed in [0.0, 1.0, 2.0, 3.0] {
-        let (mut sim, hopper) = lone_hopper(Vec2::new(speed, 0.0));
+    tracks_speeds("hopper", &[0.0, 1.0, 2.0, 3.0]);
+}
+
+#[test]
+fn the_biped_tracks_commanded_speeds_of_zero_to_two_metres_a_second() {
+    // Not yet 2.5 m/s: it runs there, but averages 2.22 m/s (issue 13's report).
+    tracks_speeds("biped", &[0.0, 1.0, 2.0]);
+}
+
+fn tracks_speeds(kind: &str, speeds: &[f32]) {
+    for &speed in speeds {
+        let (mut sim, hopper) = lone(kind, Vec2::new(speed, 0.0));
         // Settled after 8 s; averaged over the whole hops between touchdowns up to 20 s.
         let hops = touchdowns(&mut sim, hopper, 8.0, 20.0);
         let ((t0, p0), (t1, p1)) = (hops[0], *hops.last().unwrap());
@@ -97,7 +127,11 @@ fn tracks_commanded_speeds_of_zero_to_three_metres_a_second() {
 
 #[test]
 fn turns_to_a_new_heading_and_holds_it() {
-    let (mut sim, hopper) = lone_hopper(Vec2::new(1.5, 0.0));
+    turns_a_quarter_turn("hopper");
+}
+
+fn turns_a_quarter_turn(kind: &str) {
+    let (mut sim, hopper) = lone(kind, Vec2::new(1.5, 0.0));
     sim.run_for(6.0);
     let turned = Vec2::new(0.0, -1.5); // from +x to world -z: a quarter turn
     sim.app.world_mut().get_mut::<DesiredVelocity>(hopper).unwrap().0 = turned;
@@ -121,9 +155,9 @@ fn turns_to_a_new_heading_and_holds_it() {
     assert_eq!(falls(&mut sim), 0);
 }
 
-/// Hops at 1 m/s for 5 s, then takes a sideways impulse on the body.
-fn pushed(impulse_n_s: f32) -> (HeadlessSim, Entity) {
-    let (mut sim, hopper) = lone_hopper(Vec2::new(1.0, 0.0));
+/// Runs at 1 m/s for 5 s, then takes a sideways impulse on the body.
+fn pushed(kind: &str, impulse_n_s: f32) -> (HeadlessSim, Entity) {
+    let (mut sim, hopper) = lone(kind, Vec2::new(1.0, 0.0));
     sim.run_for(5.0);
     sim.app
         .world_mut()
@@ -135,11 +169,21 @@ fn pushed(impulse_n_s: f32) -> (HeadlessSim, Entity) {
 #[test]
 fn recovers_from_a_moderate_push() {
     // 10 N s on the 10.6 kg hopper: a sudden 0.94 m/s sideways.
-    let (mut sim, hopper) = pushed(10.0);
+    recovers_from_a_push("hopper", 10.0);
+}
+
+#[test]
+fn the_biped_recovers_from_a_moderate_push() {
+    // 16 N s on the 17.5 kg biped: the hopper's sudden 0.9 m/s sideways.
+    recovers_from_a_push("biped", 16.0);
+}
+
+fn recovers_from_a_push(kind: &str, impulse_n_s: f32) {
+    let (mut sim, hopper) = pushed(kind, impulse_n_s);
     sim.advance_frame();
     let sideways = state(&mut sim, hopper).unwrap().velocity.y;
     assert!(
-        sideways > 0.5 * 10.0 / hopper_mass_kg(),
+        sideways > 0.5 * impulse_n_s / mass_kg(kind),
         "the push took: {sideways} m/s sideways"
     );
     sim.run_for(15.0);
@@ -155,7 +199,17 @@ fn recovers_from_a_moderate_push() {
 #[test]
 fn a_large_push_makes_it_fall_and_it_is_respawned_without_leaking_bodies() {
     // 60 N s: a sudden 5.7 m/s sideways, more than any foot placement can catch.
-    let (mut sim, hopper) = pushed(60.0);
+    falls_from_a_push("hopper", 60.0, 3);
+}
+
+#[test]
+fn a_large_push_makes_the_biped_fall_and_it_is_respawned_without_leaking_bodies() {
+    // 100 N s on 17.5 kg: the same 5.7 m/s sideways. A body and two legs of two parts.
+    falls_from_a_push("biped", 100.0, 5);
+}
+
+fn falls_from_a_push(kind: &str, impulse_n_s: f32, parts_each: usize) {
+    let (mut sim, hopper) = pushed(kind, impulse_n_s);
     sim.run_for(8.0);
     assert_eq!(falls(&mut sim), 1);
     let world = sim.app.world_mut();
@@ -164,8 +218,8 @@ fn a_large_push_makes_it_fall_and_it_is_respawned_without_leaking_bodies() {
     assert_eq!(creatures, vec![Lod::Rigid], "a new rigid creature took its place");
     let parts = world.query::<&RigidPart>().iter(world).count();
     let bodies = world.query::<&RigidBody>().iter(world).count();
-    assert_eq!(parts, 3, "only the new hopper's three bodies remain");
-    assert_eq!(bodies, 3 + 1 + 4 + 1, "hopper, puck, walls and ground");
+    assert_eq!(parts, parts_each, "only the new creature's bodies remain");
+    assert_eq!(bodies, parts_each + 1 + 4 + 1, "creature, puck, walls and ground");
 }
 
 #[test]
@@ -185,8 +239,7 @@ fn the_default_scenario_runs_all_rigid_with_steering() {
     let mut config = default_config();
     config.scenario.level_policy = LevelPolicy::AllRigid;
     let summary = simlod::headless::run(config, 10.0);
-    // Hoppers have a rigid model; bipeds do not yet and stay point masses.
-    assert_eq!(summary.levels[Lod::Rigid], 30);
-    assert_eq!(summary.levels[Lod::PointMass], 10);
+    // Hoppers and bipeds both have a rigid model.
+    assert_eq!(summary.levels[Lod::Rigid], 40);
     assert_eq!(summary.creatures, 40);
 }

@@ -27,6 +27,8 @@ use crate::outcome::FallQueue;
 
 /// Foot centre this far above its resting height still counts as on the ground.
 pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
+/// With legs in turn, a stance this many times its expected length has stalled.
+const STALLED_STANCE_SHARE: f32 = 3.0;
 /// Share of a leg's twist about its own axis (relative to the body) removed each tick. The
 /// leg is thin, so its twist inertia is tiny: the damping is scaled to it, or it would
 /// overshoot and blow up.
@@ -143,6 +145,8 @@ impl Raibert {
 struct LegSensed {
     /// The upper leg's spin.
     spin: Vec3,
+    /// The hip, from the body's centre, in the world's axes.
+    hip: Vec3,
     /// Unit vector from hip to foot.
     axis: Vec3,
     length: f32,
@@ -188,6 +192,7 @@ impl Sensed {
             let hip_velocity = body_v.linear + body_v.angular.cross(hip_offset);
             *sensed = LegSensed {
                 spin: upper_v.angular,
+                hip: hip_offset,
                 axis,
                 length,
                 rate: (foot_v.linear - hip_velocity).dot(axis),
@@ -238,7 +243,11 @@ impl Raibert {
             StancePhase::Flight => {
                 // The leg due to land first; any other that meets the ground instead takes over.
                 let landing = self.landing_leg(legs, together);
-                let Some(touched) = (0..legs).map(|k| (landing + k) % legs).find(|&i| on_ground(i)) else {
+                // With legs in turn, not the one that just lifted off (it is retracting).
+                let Some(touched) = (0..legs)
+                    .map(|k| (landing + k) % legs)
+                    .find(|&i| on_ground(i) && (together || i != self.stance_leg))
+                else {
                     return;
                 };
                 let flight = now - self.last_liftoff_s;
@@ -246,12 +255,11 @@ impl Raibert {
                 self.thrust_m =
                     (self.thrust_m + c.thrust_gain_m_per_s * (c.flight_time_s - flight)).clamp(0.0, c.thrust_max_m);
                 self.hop_period_s = (now - self.last_touchdown_s).clamp(0.1, 2.0);
-                if let Some(along) = desired.try_normalize() {
-                    let error = desired - s.body_velocity.xz();
-                    let local_error = Vec2::new(error.dot(along), error.dot(along.perp()));
-                    self.speed_correction = (self.speed_correction + local_error * c.speed_integral_gain)
-                        .clamp_length_max(c.max_speed_correction_m_per_s);
-                }
+                let along = course(desired, s.body_rotation);
+                let error = desired - s.body_velocity.xz();
+                let local_error = Vec2::new(error.dot(along), error.dot(along.perp()));
+                self.speed_correction = (self.speed_correction + local_error * c.speed_integral_gain)
+                    .clamp_length_max(c.max_speed_correction_m_per_s);
                 self.last_touchdown_s = now;
                 self.stance_leg = touched;
                 self.phase = StancePhase::Compression;
@@ -262,7 +270,10 @@ impl Raibert {
                 self.phase = StancePhase::Thrust;
             }
             StancePhase::Compression | StancePhase::Thrust
-                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i)) =>
+                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i))
+                    // With legs in turn, a stance that stalled (the leg at its thrust length
+                    // without lifting off) ends: the leg retracts and the next one lands.
+                    || (!together && now - self.last_touchdown_s > STALLED_STANCE_SHARE * self.stance_s) =>
             {
                 self.stance_s = 0.5 * self.stance_s + 0.5 * (now - self.last_touchdown_s).clamp(0.05, 0.5);
                 self.last_liftoff_s = now;
@@ -290,9 +301,8 @@ impl Raibert {
         };
         // Foot placement: neutral point plus the speed correction.
         let v = s.body_velocity.xz();
-        let command = desired.try_normalize().map_or(desired, |along| {
-            desired + along * self.speed_correction.x + along.perp() * self.speed_correction.y
-        });
+        let along = course(desired, s.body_rotation);
+        let command = desired + along * self.speed_correction.x + along.perp() * self.speed_correction.y;
         let placement = v * (self.stance_s / 2.0) + (v - command) * c.speed_gain_s;
         // The leg the idle ones mirror: the one in stance, or the one about to land.
         let active = match self.phase {
@@ -300,6 +310,7 @@ impl Raibert {
             _ => self.stance_leg,
         };
         let stance_legs = if together { legs as f32 } else { 1.0 };
+        let heading = course(Vec2::ZERO, s.body_rotation);
         let mut stance_body = Vec3::ZERO;
         for (i, (sensed, leg)) in s.legs.iter().zip(&kind.legs).enumerate() {
             let relative_spin = sensed.spin - s.body_spin;
@@ -312,17 +323,27 @@ impl Raibert {
             let tau = match self.role(i, legs, together) {
                 Role::Landing => {
                     let reach = c.max_foot_offset_fraction * sensed.length;
-                    let offset = placement.clamp_length_max(reach);
+                    // From the body's centre: a hip off to one side lands its foot under the
+                    // body.
+                    let offset = (placement - sensed.hip.xz()).clamp_length_max(reach);
                     let down = (sensed.length * sensed.length - offset.length_squared()).sqrt();
                     swing_to(Vec3::new(offset.x, -down, offset.y).normalize_or(Vec3::NEG_Y))
                 }
                 Role::Idle => {
+                    // Mirrors the active leg fore and aft, straight under its own hip sideways
+                    // (clear of the active leg).
                     let a = s.legs[active].axis;
-                    swing_to(Vec3::new(-a.x, a.y, -a.z).normalize_or(Vec3::NEG_Y))
+                    let along = a.xz().project_onto(heading);
+                    swing_to(Vec3::new(-along.x, a.y, -along.y).normalize_or(Vec3::NEG_Y))
                 }
                 Role::Stance => {
-                    stance_body += twist;
-                    out.legs[i] = -attitude_level(s, c) / stance_legs - twist;
+                    // A hip off the body's centre: the leg's thrust there would roll and pitch
+                    // the body each step, so the hip cancels that moment about the centre (not
+                    // its yaw: a point foot has no grip to twist on).
+                    let thrust = spring_force(sensed, leg, self.spring_target(leg, r, Role::Stance));
+                    let moment = sensed.hip.cross(sensed.axis * thrust) * Vec3::new(1.0, 0.0, 1.0);
+                    stance_body += twist + moment;
+                    out.legs[i] = -attitude_level(s, c) / stance_legs - twist - moment;
                     continue;
                 }
             };
@@ -343,6 +364,14 @@ impl Raibert {
         }
         out
     }
+}
+
+/// The frame of the integral speed correction: along the command, or the body's heading when
+/// it stands still (running in place drifts too).
+fn course(desired: Vec2, body_rotation: Quat) -> Vec2 {
+    desired
+        .try_normalize()
+        .unwrap_or_else(|| (body_rotation * Vec3::X).xz().normalize_or(Vec2::X))
 }
 
 /// The stance hip torque that holds the body level (pitch and roll).
