@@ -310,20 +310,27 @@ fn bracket(rows: &[GaitRow], speed: f32) -> (&GaitRow, &GaitRow, f32) {
 }
 
 impl GaitRow {
-    /// The pose at `stride` (0..1 from the first leg's touchdown), between samples and
-    /// across the wrap.
-    fn pose(&self, stride: f32, steps: u32, sample_hz: f32) -> GaitPose {
+    /// The two samples around `stride` (0..1 from the first leg's touchdown, across the
+    /// wrap) and the weight of the second.
+    fn samples_at(&self, stride: f32, steps: u32, sample_hz: f32) -> (&[f32], &[f32], f32) {
         let n = self.samples.len();
         // Sample k was taken at k / sample_hz; as a share of the stride that is
         // k / (stride period * hz).
         let per_hop = self.hop_period_s * steps as f32 * sample_hz;
-        let x = (stride.rem_euclid(1.0) * per_hop).min(n as f32);
-        let k = (x.floor() as usize).min(n - 1);
+        // Both as the wrap and the floor would give, without their library calls (a hybrid
+        // looks its pose up every tick).
+        let stride = if (0.0..1.0).contains(&stride) {
+            stride
+        } else {
+            stride.rem_euclid(1.0)
+        };
+        let x = (stride * per_hop).min(n as f32);
+        let k = (x as usize).min(n - 1);
         let next = (k + 1) % n;
         // The last interval runs from the last sample to the next touchdown (sample 0).
         let width = if next == 0 { (per_hop - k as f32).max(1e-3) } else { 1.0 };
         let t = ((x - k as f32) / width).clamp(0.0, 1.0);
-        GaitPose::from_row(&self.samples[k]).lerp(GaitPose::from_row(&self.samples[next]), t)
+        (&self.samples[k], &self.samples[next], t)
     }
 }
 
@@ -334,12 +341,22 @@ impl GaitTable {
     }
 
     /// The pose at `speed` and `stride` phase (0..1 from the first leg's touchdown; see
-    /// [`crate::creature::GaitPhase::stride`]).
+    /// [`crate::creature::GaitPhase::stride`]): each column interpolated in phase within the
+    /// two rows around `speed`, then in speed between them.
     pub fn pose(&self, speed: f32, stride: f32) -> GaitPose {
         let (a, b, t) = bracket(&self.rows, speed);
         let steps = self.steps_per_stride;
-        a.pose(stride, steps, self.sample_hz)
-            .lerp(b.pose(stride, steps, self.sample_hz), t)
+        let (a0, a1, ta) = a.samples_at(stride, steps, self.sample_hz);
+        let (b0, b1, tb) = b.samples_at(stride, steps, self.sample_hz);
+        let mut row = [0.0; BODY_COLUMNS.len() + LEG_COLUMNS.len() * MAX_LEGS];
+        let columns = a0.len().min(row.len());
+        let samples = a0.iter().zip(a1).zip(b0.iter().zip(b1));
+        for (value, ((a0, a1), (b0, b1))) in row.iter_mut().zip(samples) {
+            let at_a = a0 + (a1 - a0) * ta;
+            let at_b = b0 + (b1 - b0) * tb;
+            *value = at_a + (at_b - at_a) * t;
+        }
+        GaitPose::from_row(&row[..columns])
     }
 
     /// Hop period and stance share at `speed`.

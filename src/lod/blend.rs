@@ -324,14 +324,18 @@ fn blend_and_measure(
     config: Res<crate::config::SimConfig>,
     kinds: Res<KindTable>,
     mut tally: ResMut<PopTally>,
-    mut creatures: Query<(
-        Entity,
-        &Creature,
-        &PlanarState,
-        &GaitPose,
-        Option<&mut SwitchProbe>,
-        Option<&SwitchBlend>,
-    )>,
+    // Only creatures in a switch's probe or blend: the rest are not visited at all.
+    mut creatures: Query<
+        (
+            Entity,
+            &Creature,
+            &PlanarState,
+            &GaitPose,
+            Option<&mut SwitchProbe>,
+            Option<&SwitchBlend>,
+        ),
+        Or<(With<SwitchProbe>, With<SwitchBlend>)>,
+    >,
 ) {
     // The time of the state this tick leaves (what is drawn until the next).
     let now = (clock.tick + 1) as f32 * clock.dt;
