@@ -91,6 +91,8 @@ pub struct Tally {
     /// Removed creatures that had collided with the puck or a wall.
     pub removed_collided: u64,
     pub falls: u64,
+    /// Falls by the level the creature was at.
+    pub falls_by_level: Counts<Lod, u64>,
     /// Falls within one step of a switch into the rigid level.
     pub falls_after_switch: u64,
     pub respawns: u64,
@@ -238,6 +240,7 @@ fn respawn_fallen(
         }
         tally.removed_collided += u64::from(record.hit_puck_or_wall());
         tally.falls += 1;
+        tally.falls_by_level[*lod] += 1;
         tally.respawns += 1;
         let radius = config.kinds[creature.kind].body.radius_m;
         let spot = find_free_spot(&mut rng, half, radius + clear, radius + clear, |p| {
@@ -272,6 +275,8 @@ pub struct Summary {
     /// Creatures that collided with the puck or a wall (the paper's figure 10 measure).
     pub creatures_collided: u64,
     pub falls: u64,
+    /// Falls by the level the creature was at when it fell.
+    pub falls_by_level: Counts<Lod, u64>,
     /// Falls within one step (touchdown to touchdown) of a switch into the rigid level.
     pub falls_after_switch: u64,
     pub respawns: u64,
@@ -323,6 +328,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         collisions,
         creatures_collided: collided,
         falls: tally.falls,
+        falls_by_level: tally.falls_by_level,
         falls_after_switch: tally.falls_after_switch,
         respawns: tally.respawns,
         levels,

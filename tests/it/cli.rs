@@ -28,6 +28,7 @@ fn run_json_has_the_keys_of_the_summary() {
         "collisions",
         "creatures_collided",
         "respawns",
+        "falls_by_level",
         "levels",
         "levels_mean",
         "switches",
@@ -49,6 +50,13 @@ fn run_json_has_the_keys_of_the_summary() {
         .map(|v| v.as_u64().unwrap())
         .sum();
     assert_eq!(levels, creatures, "every creature is at one level: {summary}");
+    let by_level: u64 = summary["falls_by_level"]
+        .as_object()
+        .unwrap()
+        .values()
+        .map(|v| v.as_u64().unwrap())
+        .sum();
+    assert_eq!(by_level, summary["falls"], "every fall is at one level: {summary}");
 }
 
 /// A user's mistake is one clear message and exit status 2, never a panic.

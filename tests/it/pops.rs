@@ -22,7 +22,7 @@ fn game(blended: bool) -> SimConfig {
 }
 
 #[test]
-fn over_whole_games_the_blend_keeps_nearly_every_switch_under_the_bars() {
+fn over_whole_games_every_switch_is_drawn_under_the_bars() {
     // The paper's rules, the camera rule (its point masses out of view), and areas of
     // influence shrunk to nothing, so that creatures go rigid only when a collision forces it.
     let mut camera = game(true);
@@ -78,10 +78,12 @@ fn over_whole_games_the_blend_keeps_nearly_every_switch_under_the_bars() {
         "{measured} of {switches} switches measured ({falls} falls)"
     );
     for p in &pops {
-        // Every switch within 2 cm and 2 degrees as drawn (the bar is 1 cm for switches
-        // in the window: not yet held by all, see the figures printed above), and the blend at
-        // least halves each kind's largest jump in metres.
-        assert!(p.metres.max < 0.02 && p.degrees.max < 2.0, "{p:?}");
+        // The bars, as drawn: in the flight window under 1 cm and 2 degrees, forced by
+        // a collision under 2 cm and 5 degrees, the body's velocity within 0.1 m/s; and the
+        // blend at least halves each kind's largest jump in metres.
+        let (metres, degrees) = if p.forced { (0.02, 5.0) } else { (0.01, 2.0) };
+        assert!(p.metres.max < metres && p.degrees.max < degrees, "{p:?}");
+        assert!(p.velocity_m_per_s.max < 0.1, "{p:?}");
         assert!(p.metres.max * 2.0 < p.model_metres.max, "{p:?}");
     }
     // The models alone do pop: that is what the blend hides.
