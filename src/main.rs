@@ -45,9 +45,10 @@ struct RecordGaitArgs {
     /// The creature file; it must have a `rigid` section.
     #[arg(long)]
     creature: PathBuf,
-    /// Steady forward speeds to record, increasing.
-    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3")]
-    speeds: Vec<f32>,
+    /// Steady forward speeds to record, increasing (default: each whole m/s below the kind's
+    /// top speed, and the top speed).
+    #[arg(long, value_delimiter = ',')]
+    speeds: Option<Vec<f32>>,
     /// Where to write the table (default: the creature's `gait_table`, or gaits/<kind>.ron
     /// under the assets folder).
     #[arg(long)]
@@ -64,13 +65,11 @@ impl RecordGaitArgs {
                 self.creature.display()
             ));
         }
-        if self.speeds.is_empty()
-            || self.speeds.windows(2).any(|w| w[0] >= w[1])
-            || self.speeds.iter().any(|v| !(0.0..=10.0).contains(v))
-        {
+        let defaults = RecordSettings::up_to(def.top_speed_m_per_s);
+        let speeds = self.speeds.clone().unwrap_or_else(|| defaults.speeds_m_per_s.clone());
+        if speeds.is_empty() || speeds.windows(2).any(|w| w[0] >= w[1]) || speeds.iter().any(|v| !(0.0..=10.0).contains(v)) {
             return Err(format!(
-                "--speeds must be increasing speeds between 0 and 10 m/s, got {:?}",
-                self.speeds
+                "--speeds must be increasing speeds between 0 and 10 m/s, got {speeds:?}"
             ));
         }
         // The recording never depends on a table recorded before.
@@ -86,8 +85,8 @@ impl RecordGaitArgs {
             count: 1,
         }];
         let settings = RecordSettings {
-            speeds_m_per_s: self.speeds.clone(),
-            ..RecordSettings::default()
+            speeds_m_per_s: speeds.clone(),
+            ..defaults
         };
         let table = record(&config, &def.name, &settings)?;
         let out = self.out.clone().unwrap_or_else(|| {
@@ -97,7 +96,7 @@ impl RecordGaitArgs {
                     .unwrap_or_else(|| format!("gaits/{}.ron", def.name)),
             )
         });
-        let speeds: Vec<String> = self.speeds.iter().map(f32::to_string).collect();
+        let speeds: Vec<String> = speeds.iter().map(f32::to_string).collect();
         let command = format!(
             "simlod record-gait --creature {} --speeds {}",
             self.creature.display(),
