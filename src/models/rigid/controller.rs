@@ -90,8 +90,14 @@ impl Raibert {
             .legs
             .iter()
             .fold(kind.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg);
-        let stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
-        let hop_period_s = stance_s + r.controller.flight_time_s;
+        let mut stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
+        let mut hop_period_s = stance_s + r.controller.flight_time_s;
+        // In flight from the hybrid level, as the entry pose is: the table's rhythm, so the
+        // legs' servos (idle_leg_swap_s) go on where the table's legs were.
+        if kind.gait.is_some() && gait.in_flight && gait.hop_period_s > 0.0 {
+            hop_period_s = gait.hop_period_s;
+            stance_s = gait.stance_fraction * hop_period_s;
+        }
         let last_touchdown_s = now - gait.cycle * hop_period_s;
         Self {
             phase: StancePhase::Flight,
