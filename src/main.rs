@@ -67,7 +67,10 @@ impl RecordGaitArgs {
         }
         let defaults = RecordSettings::up_to(def.top_speed_m_per_s);
         let speeds = self.speeds.clone().unwrap_or_else(|| defaults.speeds_m_per_s.clone());
-        if speeds.is_empty() || speeds.windows(2).any(|w| w[0] >= w[1]) || speeds.iter().any(|v| !(0.0..=10.0).contains(v)) {
+        if speeds.is_empty()
+            || speeds.windows(2).any(|w| w[0] >= w[1])
+            || speeds.iter().any(|v| !(0.0..=10.0).contains(v))
+        {
             return Err(format!(
                 "--speeds must be increasing speeds between 0 and 10 m/s, got {speeds:?}"
             ));
@@ -343,6 +346,27 @@ struct BenchArgs {
     /// Only this level (no cost ratios, no game).
     #[arg(long, value_enum)]
     level: Option<Lod>,
+    /// Only the scenario's creatures of this kind (for example `biped`): its cost at each level.
+    #[arg(long)]
+    kind: Option<String>,
+}
+
+impl BenchArgs {
+    fn run(&self) -> Result<(), String> {
+        let mut config = self.scenario.load()?;
+        if let Some(kind) = &self.kind {
+            let all: Vec<String> = config.scenario.creatures.iter().map(|g| g.kind.clone()).collect();
+            config.scenario.creatures.retain(|g| &g.kind == kind);
+            if config.scenario.creatures.is_empty() {
+                return Err(format!(
+                    "--kind {kind}: the scenario has no creatures of that kind (it has {})",
+                    all.join(", ")
+                ));
+            }
+        }
+        bench::run(&config, self.quick, self.json, self.level);
+        Ok(())
+    }
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
@@ -435,10 +459,7 @@ fn main() -> ExitCode {
             }
         }),
         Some(Command::RecordGait(args)) => args.run(),
-        Some(Command::Bench(args)) => args
-            .scenario
-            .load()
-            .map(|config| bench::run(&config, args.quick, args.json, args.level)),
+        Some(Command::Bench(args)) => args.run(),
         Some(Command::Experiment(ExperimentArgs { which })) => match which {
             ExperimentKind::StepResponse(run) => run.run("step-response"),
             ExperimentKind::Table1(run) => run.run("table1"),

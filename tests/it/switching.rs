@@ -123,7 +123,12 @@ fn switches_happen_only_inside_the_flight_window_unless_a_collision_forces_them(
     let kinds: Vec<(Vec<Vec3>, f32)> = config
         .kinds
         .iter()
-        .map(|k| (k.legs.iter().map(|l| Vec3::from(l.hip_m)).collect(), k.legs[0].foot_radius_m))
+        .map(|k| {
+            (
+                k.legs.iter().map(|l| Vec3::from(l.hip_m)).collect(),
+                k.legs[0].foot_radius_m,
+            )
+        })
         .collect();
     let mut sim = watched(config);
     sim.run_for(20.0);
@@ -328,12 +333,13 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
     config.rules.influence.puck_radius_m = 4.0;
     config.rules.min_dwell_s = 0.1;
     config.rules.release_margin_m = 0.3;
-    let (hopper, biped) = (config.kind_index("hopper").unwrap(), config.kind_index("biped").unwrap());
+    let (hopper, biped) = (
+        config.kind_index("hopper").unwrap(),
+        config.kind_index("biped").unwrap(),
+    );
     let legs: Vec<usize> = config.kinds.iter().map(|k| k.legs.len()).collect();
     let mut sim = HeadlessSim::new(config);
     let mut baseline = None;
-    // Creatures at each level, summed over the checks: every level is visited.
-    let mut at_level = HashMap::new();
     while sim.clock().seconds() < 600.0 {
         sim.run_for(60.0);
         let world = sim.app.world_mut();
@@ -344,10 +350,11 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
             .collect();
         assert_eq!(creatures.len(), 100);
         for (kind, count) in [(hopper, 70), (biped, 30)] {
-            assert_eq!(creatures.iter().filter(|c| c.1 == kind).count(), count, "no creature lost");
-        }
-        for level in [Lod::PointMass, Lod::Hybrid, Lod::Rigid] {
-            *at_level.entry(level).or_insert(0) += creatures.iter().filter(|c| c.0 == level).count();
+            assert_eq!(
+                creatures.iter().filter(|c| c.1 == kind).count(),
+                count,
+                "no creature lost"
+            );
         }
         let rigid = creatures.iter().filter(|c| c.0 == Lod::Rigid).count();
         // A body and two parts a leg.
@@ -386,12 +393,16 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
         assert_eq!(*baseline.get_or_insert(others), others, "entities besides the bodies");
     }
     let summary = sim.summary(0.0);
-    eprintln!(
-        "soak: {:?} switches, {} falls, creatures at each level summed over the checks {at_level:?}",
-        summary.switches, summary.falls
-    );
+    eprintln!("soak: {:?} switches, {} falls", summary.switches, summary.falls);
+    // Every level entered, again and again.
     for level in [Lod::PointMass, Lod::Hybrid, Lod::Rigid] {
-        assert!(at_level[&level] > 0, "no creature at {level:?}");
+        let into: u64 = summary
+            .switches
+            .directions()
+            .filter(|d| d.1 == level)
+            .map(|d| d.2)
+            .sum();
+        assert!(into >= 10, "{into} switches into {level:?}");
     }
     assert!(summary.switches.total() >= 10_000, "{:?}", summary.switches);
 }
@@ -432,8 +443,7 @@ fn a_margin_at_the_edge_of_the_view_cone_keeps_creatures_there_from_flickering()
     // A flicker is a creature going into view and back out (or out and back in) within a
     // second, two hops.
     let flickers = |margin_deg: f32| {
-        let mut config = default_config();
-        config.scenario.level_policy = LevelPolicy::Camera;
+        let mut config = scene(&[("hopper", 30), ("biped", 10)], LevelPolicy::Camera);
         config.rules.min_dwell_s = 0.0;
         config.rules.release_margin_m = 0.0;
         config.rules.release_margin_deg = margin_deg;
@@ -444,7 +454,11 @@ fn a_margin_at_the_edge_of_the_view_cone_keeps_creatures_there_from_flickering()
         for o in &sim.app.world().resource::<Watch>().seen {
             let s = o.switch;
             let across_edge = |a: Lod, b: Lod| a.min(b) == Lod::PointMass && a != b;
+            // A collision forcing a creature rigid, and its going back, is not the view's edge.
+            let windowed = |s: &LevelSwitched| s.flight_progress.is_some();
             if let Some(p) = last.get(&s.serial)
+                && windowed(p)
+                && windowed(&s)
                 && across_edge(s.from, s.to)
                 && (p.from, p.to) == (s.to, s.from)
                 && s.at_s - p.at_s < 1.0
