@@ -45,9 +45,10 @@ struct RecordGaitArgs {
     /// The creature file; it must have a `rigid` section.
     #[arg(long)]
     creature: PathBuf,
-    /// Steady forward speeds to record, increasing.
-    #[arg(long, value_delimiter = ',', default_value = "0,1,2,3")]
-    speeds: Vec<f32>,
+    /// Steady forward speeds to record, increasing (default: each whole m/s below the kind's
+    /// top speed, and the top speed).
+    #[arg(long, value_delimiter = ',')]
+    speeds: Option<Vec<f32>>,
     /// Where to write the table (default: the creature's `gait_table`, or gaits/<kind>.ron
     /// under the assets folder).
     #[arg(long)]
@@ -64,13 +65,14 @@ impl RecordGaitArgs {
                 self.creature.display()
             ));
         }
-        if self.speeds.is_empty()
-            || self.speeds.windows(2).any(|w| w[0] >= w[1])
-            || self.speeds.iter().any(|v| !(0.0..=10.0).contains(v))
+        let defaults = RecordSettings::up_to(def.top_speed_m_per_s);
+        let speeds = self.speeds.clone().unwrap_or_else(|| defaults.speeds_m_per_s.clone());
+        if speeds.is_empty()
+            || speeds.windows(2).any(|w| w[0] >= w[1])
+            || speeds.iter().any(|v| !(0.0..=10.0).contains(v))
         {
             return Err(format!(
-                "--speeds must be increasing speeds between 0 and 10 m/s, got {:?}",
-                self.speeds
+                "--speeds must be increasing speeds between 0 and 10 m/s, got {speeds:?}"
             ));
         }
         // The recording never depends on a table recorded before.
@@ -86,8 +88,8 @@ impl RecordGaitArgs {
             count: 1,
         }];
         let settings = RecordSettings {
-            speeds_m_per_s: self.speeds.clone(),
-            ..RecordSettings::default()
+            speeds_m_per_s: speeds.clone(),
+            ..defaults
         };
         let table = record(&config, &def.name, &settings)?;
         let out = self.out.clone().unwrap_or_else(|| {
@@ -97,7 +99,7 @@ impl RecordGaitArgs {
                     .unwrap_or_else(|| format!("gaits/{}.ron", def.name)),
             )
         });
-        let speeds: Vec<String> = self.speeds.iter().map(f32::to_string).collect();
+        let speeds: Vec<String> = speeds.iter().map(f32::to_string).collect();
         let command = format!(
             "simlod record-gait --creature {} --speeds {}",
             self.creature.display(),
@@ -344,6 +346,27 @@ struct BenchArgs {
     /// Only this level (no cost ratios, no game).
     #[arg(long, value_enum)]
     level: Option<Lod>,
+    /// Only the scenario's creatures of this kind (for example `biped`): its cost at each level.
+    #[arg(long)]
+    kind: Option<String>,
+}
+
+impl BenchArgs {
+    fn run(&self) -> Result<(), String> {
+        let mut config = self.scenario.load()?;
+        if let Some(kind) = &self.kind {
+            let all: Vec<String> = config.scenario.creatures.iter().map(|g| g.kind.clone()).collect();
+            config.scenario.creatures.retain(|g| &g.kind == kind);
+            if config.scenario.creatures.is_empty() {
+                return Err(format!(
+                    "--kind {kind}: the scenario has no creatures of that kind (it has {})",
+                    all.join(", ")
+                ));
+            }
+        }
+        bench::run(&config, self.quick, self.json, self.level);
+        Ok(())
+    }
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
@@ -436,10 +459,7 @@ fn main() -> ExitCode {
             }
         }),
         Some(Command::RecordGait(args)) => args.run(),
-        Some(Command::Bench(args)) => args
-            .scenario
-            .load()
-            .map(|config| bench::run(&config, args.quick, args.json, args.level)),
+        Some(Command::Bench(args)) => args.run(),
         Some(Command::Experiment(ExperimentArgs { which })) => match which {
             ExperimentKind::StepResponse(run) => run.run("step-response"),
             ExperimentKind::Table1(run) => run.run("table1"),

@@ -147,6 +147,10 @@ pub struct RaibertConfig {
     /// Legs in turn: how much an idle leg is shortened below its rest length to clear the
     /// ground while it swings to its next touchdown.
     pub idle_leg_retract_m: f32,
+    /// Legs in turn: from a lift-off, the time over which the leg that lifted off shortens by
+    /// `idle_leg_retract_m` and the leg that lands next lengthens back to rest (a leg servo,
+    /// not a jump: a gait table sampled at 30 Hz can follow it). 0: at once.
+    pub idle_leg_swap_s: f32,
     /// Largest yaw error acted on at once, so a reversal turns smoothly, not violently.
     pub max_yaw_error_rad: f32,
     /// Below this desired speed the body keeps its heading.
@@ -327,6 +331,7 @@ impl RigidConfig {
                 ("turn_min_speed_m_per_s", c.turn_min_speed_m_per_s, 50.0),
                 ("max_speed_correction_m_per_s", c.max_speed_correction_m_per_s, 50.0),
                 ("idle_leg_retract_m", c.idle_leg_retract_m, 5.0),
+                ("idle_leg_swap_s", c.idle_leg_swap_s, 5.0),
             ] {
                 v.range(name, value, 0.0, most);
             }

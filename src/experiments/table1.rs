@@ -140,10 +140,12 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     let ratio = |m: usize, cheap: usize| ms[2][m] / ms[cheap][m];
     let mut report = format!(
         "The cost of one creature for 1/30 s of motion, the median over {n_trials} fresh runs of each run's median of {frames} frames \
-         (after {warmup} warm-up frames), one measurement at a time in one process, {} hoppers at the point-mass and hybrid levels and {} rigid. \
+         (after {warmup} warm-up frames), one measurement at a time in one process, {} {kind}s at the point-mass and hybrid levels and {} rigid. \
          *Model alone* is the paper's measure (simulation and low-level control; no steering, collisions or rendering); *game* adds steering, the level rules and collisions.\n\n\
          | level | paper (ms) | simlod, model alone (ms) | simlod, game (ms) |\n|---|---|---|---|\n",
-        counts[0], counts[2]
+        counts[0],
+        counts[2],
+        kind = s.creature
     );
     for i in 0..3 {
         let _ = writeln!(

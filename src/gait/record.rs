@@ -37,6 +37,19 @@ pub struct RecordSettings {
     pub sample_hz: f32,
 }
 
+impl RecordSettings {
+    /// The default recording of a kind whose top speed is `top_m_per_s`: every whole metre a
+    /// second below it, and the top speed itself (the paper's 0, 1, 2, 3 m/s for a top speed of
+    /// 3 m/s).
+    pub fn up_to(top_m_per_s: f32) -> Self {
+        let whole = (0..).map(|v| v as f32).take_while(|&v| v < top_m_per_s - 0.05);
+        Self {
+            speeds_m_per_s: whole.chain([top_m_per_s]).collect(),
+            ..Self::default()
+        }
+    }
+}
+
 impl Default for RecordSettings {
     fn default() -> Self {
         Self {

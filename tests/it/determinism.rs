@@ -30,8 +30,7 @@ fn another_seed_gives_another_game() {
 
 #[test]
 fn the_rigid_level_is_deterministic_too() {
-    let mut config = default_config();
-    config.scenario.level_policy = simlod::lod::LevelPolicy::AllRigid;
+    let config = scene(&[("hopper", 30), ("biped", 10)], simlod::lod::LevelPolicy::AllRigid);
     let a = digest_after(config.clone(), 5.0);
     assert_eq!(a, digest_after(config, 5.0));
     assert_eq!(a.1.levels[Lod::Rigid], 40);

@@ -11,20 +11,41 @@ use simlod::gait::{GaitPose, GaitTable, columns};
 use simlod::lod::{LevelPolicy, Lod};
 
 const SHIPPED: &str = "gaits/hopper.ron";
-const COMMAND: &str = "simlod record-gait --creature assets/creatures/hopper.ron --speeds 0,1,2,3";
+
+/// Records `kind`'s table as `simlod record-gait` does by default and compares it with the
+/// shipped one, byte for byte.
+fn recording_again_reproduces(kind: &str, command: &str) {
+    let mut config = default_config();
+    let index = config.kind_index(kind).unwrap();
+    config.gaits[index] = None; // as record-gait does: never from an earlier table
+    let settings = RecordSettings::up_to(config.kinds[index].top_speed_m_per_s);
+    let table = record(&config, kind, &settings).unwrap();
+    let shipped = std::fs::read_to_string(assets_root().join(format!("gaits/{kind}.ron"))).unwrap();
+    assert!(
+        shipped.contains(command),
+        "the shipped table's header names the command that made it"
+    );
+    assert_eq!(to_file_text(&table, command), shipped);
+}
 
 #[test]
 fn recording_again_reproduces_the_shipped_table() {
-    let mut config = default_config();
-    let hopper = config.kind_index("hopper").unwrap();
-    config.gaits[hopper] = None; // as record-gait does: never from an earlier table
-    let table = record(&config, "hopper", &RecordSettings::default()).unwrap();
-    let shipped = std::fs::read_to_string(assets_root().join(SHIPPED)).unwrap();
-    assert!(
-        shipped.contains(COMMAND),
-        "the shipped table's header names the command that made it"
+    recording_again_reproduces(
+        "hopper",
+        "simlod record-gait --creature assets/creatures/hopper.ron --speeds 0,1,2,3",
     );
-    assert_eq!(to_file_text(&table, COMMAND), shipped);
+}
+
+#[test]
+fn recording_the_biped_again_reproduces_its_shipped_table_with_both_legs() {
+    recording_again_reproduces(
+        "biped",
+        "simlod record-gait --creature assets/creatures/biped.ron --speeds 0,1,2,2.5",
+    );
+    let config = default_config();
+    let table = config.gaits[config.kind_index("biped").unwrap()].as_ref().unwrap();
+    assert_eq!(table.columns, columns(2));
+    assert_eq!(table.steps_per_stride, 2, "a stride is a step of each leg");
 }
 
 #[test]
@@ -109,15 +130,16 @@ fn an_empty_table_is_refused() {
     assert!(err.to_string().contains("the table is empty"), "{err}");
 }
 
-/// Runs a rigid and a hybrid hopper side by side at `speed` and compares their poses at the
-/// same phase of the hop, once settled: the largest gap in each of the table's columns.
-fn pose_gap(speed: f32) -> [f32; 6] {
+/// Runs a rigid and a hybrid creature of `kind` side by side at `speed` and compares their
+/// poses at the same phase of the stride, once settled: the largest gap in each of the table's
+/// columns.
+fn pose_gap(kind: &str, speed: f32) -> Vec<f32> {
     let config: SimConfig = default_config();
     let start = Vec2::new(-180.0, 0.0);
     let mut runners: Vec<_> = [LevelPolicy::AllRigid, LevelPolicy::AllHybrid]
         .into_iter()
         .map(|policy| {
-            let (mut sim, e) = lone_creature(&config, "hopper", policy, start, 420.0);
+            let (mut sim, e) = lone_creature(&config, kind, policy, start, 420.0);
             sim.app
                 .world_mut()
                 .entity_mut(e)
@@ -126,16 +148,16 @@ fn pose_gap(speed: f32) -> [f32; 6] {
             (sim, e)
         })
         .collect();
-    let table = config.gaits[0].clone().unwrap();
-    let mut gap = [0.0f32; 6];
+    let table = config.gaits[config.kind_index(kind).unwrap()].clone().unwrap();
+    let mut gap = vec![0.0f32; table.columns.len()];
     for _ in 0..90 {
         for (sim, _) in &mut runners {
             sim.advance_frame();
         }
-        // The rigid hopper's phase, measured; the table's pose at that phase and speed.
+        // The rigid creature's phase, measured; the table's pose at that phase and speed.
         let (sim, e) = &runners[0];
         let world = sim.app.world();
-        assert_eq!(world.get::<Lod>(*e), Some(&Lod::Rigid), "the rigid hopper is standing");
+        assert_eq!(world.get::<Lod>(*e), Some(&Lod::Rigid), "the rigid {kind} is standing");
         let rigid = *world.get::<GaitPose>(*e).unwrap();
         let phase = world.get::<GaitPhase>(*e).unwrap().stride(table.steps_per_stride);
         let speed_now = world.get::<PlanarState>(*e).unwrap().velocity.length();
@@ -153,33 +175,44 @@ fn pose_gap(speed: f32) -> [f32; 6] {
     gap
 }
 
-#[test]
-fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
-    // What a viewer sees of a hopper 0.8 m tall: a few centimetres of height and a few
+/// The table of `kind` played at its rigid model's own phase and speed stays within the
+/// limits at each of `speeds`.
+fn hybrid_pose_follows_the_rigid_model(kind: &str, speeds: &[f32]) {
+    // What a viewer sees of a creature 0.8-0.9 m tall: a few centimetres of height and a few
     // degrees of body or leg angle are invisible at game distances; the hop itself is 25 cm
     // and the leg swings 25 degrees.
-    // Limits by column: body height, roll, pitch, leg length, leg forward, leg sideways
-    // (lengths in metres, angles in degrees).
-    let limits = [0.05, 5.0, 5.0, 0.05, 8.0, 8.0];
-    for speed in [0.0, 1.5, 2.0, 2.8] {
-        let gap = pose_gap(speed);
-        for (i, (column, limit)) in columns(1).iter().zip(limits).enumerate() {
+    // Limits by column: body height, roll, pitch, then each leg's length, forward and
+    // sideways angles (lengths in metres, angles in degrees).
+    let (body, leg) = ([0.05, 5.0, 5.0], [0.05, 8.0, 8.0]);
+    for &speed in speeds {
+        let gap = pose_gap(kind, speed);
+        let limits = body.iter().chain(leg.iter().cycle()).copied();
+        for (i, (column, limit)) in columns((gap.len() - 3) / 3).iter().zip(limits).enumerate() {
             let g = if column.ends_with("_rad") {
                 gap[i].to_degrees()
             } else {
                 gap[i]
             };
-            eprintln!("{speed} m/s: largest gap in {column}: {g:.4}");
-            assert!(g < limit, "{speed} m/s: {column} off by {g} (limit {limit})");
+            eprintln!("{kind} at {speed} m/s: largest gap in {column}: {g:.4}");
+            assert!(g < limit, "{kind} at {speed} m/s: {column} off by {g} (limit {limit})");
         }
     }
 }
 
 #[test]
-fn the_default_scenario_runs_all_hybrid() {
-    let mut config = default_config();
-    config.scenario.level_policy = LevelPolicy::AllHybrid;
+fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
+    hybrid_pose_follows_the_rigid_model("hopper", &[0.0, 1.5, 2.0, 2.8]);
+}
+
+#[test]
+fn at_steady_speeds_the_hybrid_biped_follows_the_rigid_biped() {
+    // Both legs' columns, at the table's rows and between them, up to near its top speed.
+    hybrid_pose_follows_the_rigid_model("biped", &[0.0, 1.5, 2.0, 2.4]);
+}
+
+#[test]
+fn hoppers_and_bipeds_run_all_hybrid() {
+    let config = scene(&[("hopper", 30), ("biped", 10)], LevelPolicy::AllHybrid);
     let summary = simlod::headless::run(config, 10.0);
-    assert_eq!(summary.levels[Lod::Hybrid], 30, "hoppers have a gait table");
-    assert_eq!(summary.levels[Lod::PointMass], 10, "bipeds have none yet");
+    assert_eq!(summary.levels[Lod::Hybrid], 40, "hoppers and bipeds have a gait table");
 }

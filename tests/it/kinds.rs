@@ -213,31 +213,47 @@ fn the_shipped_stilt_is_asset_files_alone_and_its_table_is_the_commands() {
     assert_eq!(to_file_text(&table, command), shipped);
 
     // Every policy moves its stilts at that level.
+    every_fixed_policy_moves(three_kinds, "stilt", 10);
+}
+
+#[test]
+fn every_fixed_policy_moves_hoppers_and_bipeds_at_its_level() {
+    // The default game's two kinds, in a scene of their own.
+    let make = |policy| crate::support::scene(&[("hopper", 30), ("biped", 10)], policy);
+    every_fixed_policy_moves(make, "hopper", 30);
+    every_fixed_policy_moves(make, "biped", 10);
+}
+
+/// Under each fixed policy, the `count` creatures of `kind` in the world `make` builds are
+/// all at that policy's level after 3 s, and at least half of them moved.
+fn every_fixed_policy_moves(make: impl Fn(LevelPolicy) -> SimConfig, kind: &str, count: usize) {
     for (policy, level) in [
         (LevelPolicy::AllPointMass, Lod::PointMass),
         (LevelPolicy::AllHybrid, Lod::Hybrid),
         (LevelPolicy::AllRigid, Lod::Rigid),
     ] {
-        let mut sim = HeadlessSim::new(three_kinds(policy));
-        let stilts = |sim: &mut HeadlessSim| -> Vec<(Lod, Vec2)> {
+        let config = make(policy);
+        let index = config.kind_index(kind).unwrap();
+        let mut sim = HeadlessSim::new(config);
+        let of_kind = |sim: &mut HeadlessSim| -> Vec<(Lod, Vec2)> {
             let world = sim.app.world_mut();
             world
                 .query::<(&Creature, &Lod, &PlanarState)>()
                 .iter(world)
-                .filter(|(c, _, _)| c.kind == stilt)
+                .filter(|(c, _, _)| c.kind == index)
                 .map(|(_, l, s)| (*l, s.position))
                 .collect()
         };
-        let before = stilts(&mut sim);
+        let before = of_kind(&mut sim);
         sim.run_for(3.0);
-        let after = stilts(&mut sim);
-        assert_eq!(after.len(), 10, "{policy:?}");
-        assert!(after.iter().all(|(l, _)| *l == level), "{policy:?}: {after:?}");
+        let after = of_kind(&mut sim);
+        assert_eq!(after.len(), count, "{kind}, {policy:?}");
+        assert!(after.iter().all(|(l, _)| *l == level), "{kind}, {policy:?}: {after:?}");
         let moved = before
             .iter()
             .zip(&after)
             .filter(|(a, b)| a.1.distance(b.1) > 0.1)
             .count();
-        assert!(moved >= 5, "{policy:?}: {moved} of 10 stilts moved");
+        assert!(moved >= count / 2, "{kind}, {policy:?}: {moved} of {count} moved");
     }
 }

@@ -18,6 +18,8 @@ use simlod::outcome::CollisionRecord;
 /// What the test sees of a creature at the end of a tick.
 #[derive(Clone, Copy, Debug)]
 struct Seen {
+    /// The creature's kind (its index in the config's kinds).
+    kind: usize,
     state: PlanarState,
     pose: GaitPose,
     touching: bool,
@@ -28,20 +30,25 @@ struct Seen {
 #[derive(Clone, Debug)]
 struct Observed {
     switch: LevelSwitched,
+    /// The tick before `before`.
+    earlier: Seen,
     before: Seen,
     after: Seen,
 }
 
 #[derive(Resource, Default)]
 struct Watch {
+    /// Each creature at the end of the last tick, and of the one before.
     last: HashMap<Entity, Seen>,
+    earlier: HashMap<Entity, Seen>,
     seen: Vec<Observed>,
 }
 
-type Looks<'a> = (&'a PlanarState, &'a GaitPose, &'a CollisionRecord);
+type Looks<'a> = (&'a Creature, &'a PlanarState, &'a GaitPose, &'a CollisionRecord);
 
-fn seen((state, pose, record): Looks) -> Seen {
+fn seen((creature, state, pose, record): Looks) -> Seen {
     Seen {
+        kind: creature.kind,
         state: *state,
         pose: *pose,
         touching: record.touching.iter().any(|&t| t),
@@ -49,7 +56,8 @@ fn seen((state, pose, record): Looks) -> Seen {
 }
 
 fn remember(mut watch: ResMut<Watch>, creatures: Query<(Entity, Looks)>) {
-    watch.last = creatures.iter().map(|(e, looks)| (e, seen(looks))).collect();
+    let now = creatures.iter().map(|(e, looks)| (e, seen(looks))).collect();
+    watch.earlier = std::mem::replace(&mut watch.last, now);
 }
 
 fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>, creatures: Query<Looks>) {
@@ -57,8 +65,10 @@ fn observe(mut watch: ResMut<Watch>, mut switched: MessageReader<LevelSwitched>,
         let (Some(before), Ok(after)) = (watch.last.get(&s.creature).copied(), creatures.get(s.creature)) else {
             continue;
         };
+        let earlier = watch.earlier.get(&s.creature).copied().unwrap_or(before);
         watch.seen.push(Observed {
             switch: *s,
+            earlier,
             before,
             after: seen(after),
         });
@@ -71,6 +81,20 @@ fn foot_height(pose: &GaitPose, hips: &[Vec3]) -> f32 {
         .hips_and_feet(hips)
         .map(|(_, foot)| foot.y)
         .fold(f32::INFINITY, f32::min)
+}
+
+/// Pose `b` continued one tick by its motion since the pose `e` of the tick before.
+fn continued(e: GaitPose, b: GaitPose) -> GaitPose {
+    let mut p = b;
+    p.body_height_m += b.body_height_m - e.body_height_m;
+    p.roll_rad += b.roll_rad - e.roll_rad;
+    p.pitch_rad += b.pitch_rad - e.pitch_rad;
+    for ((leg, lb), le) in p.legs_mut().iter_mut().zip(b.legs()).zip(e.legs()) {
+        leg.length_m += lb.length_m - le.length_m;
+        leg.forward_rad += lb.forward_rad - le.forward_rad;
+        leg.sideways_rad += lb.sideways_rad - le.sideways_rad;
+    }
+    p
 }
 
 /// A simulation stepped one tick per update, watching every switch.
@@ -94,14 +118,25 @@ fn influence_config() -> SimConfig {
 fn switches_happen_only_inside_the_flight_window_unless_a_collision_forces_them() {
     let config = influence_config();
     let (open, close) = config.rules.flight_window;
-    let hopper = &config.kinds[config.kind_index("hopper").unwrap()];
-    let foot_radius = hopper.legs[0].foot_radius_m;
-    let hips: Vec<Vec3> = hopper.legs.iter().map(|l| Vec3::from(l.hip_m)).collect();
+    let biped = config.kind_index("biped").unwrap();
+    // Each kind's hips, and its feet's radius.
+    let kinds: Vec<(Vec<Vec3>, f32)> = config
+        .kinds
+        .iter()
+        .map(|k| {
+            (
+                k.legs.iter().map(|l| Vec3::from(l.hip_m)).collect(),
+                k.legs[0].foot_radius_m,
+            )
+        })
+        .collect();
     let mut sim = watched(config);
     sim.run_for(20.0);
     let seen = &sim.app.world().resource::<Watch>().seen;
     let (windowed, forced): (Vec<_>, Vec<_>) = seen.iter().partition(|o| o.switch.flight_progress.is_some());
     assert!(windowed.len() >= 30, "{} switches in the window", windowed.len());
+    let bipeds = windowed.iter().filter(|o| o.before.kind == biped).count();
+    assert!(bipeds >= 5, "{bipeds} bipeds switched in the window");
     for o in &windowed {
         let p = o.switch.flight_progress.unwrap();
         assert!(
@@ -109,9 +144,10 @@ fn switches_happen_only_inside_the_flight_window_unless_a_collision_forces_them(
             "switched at {p} of the flight phase: {:?}",
             o.switch
         );
-        // Seen from outside the switch: the foot was off the ground, whether the bodies or
-        // the gait table put it there.
-        let clearance = foot_height(&o.before.pose, &hips) - foot_radius;
+        // Seen from outside the switch: every foot was off the ground (a biped's flight is
+        // both feet off), whether the bodies or the gait table put them there.
+        let (hips, foot_radius) = &kinds[o.before.kind];
+        let clearance = foot_height(&o.before.pose, hips) - foot_radius;
         assert!(
             clearance > 0.0,
             "{:?}: the foot was {clearance} m off the ground",
@@ -162,8 +198,10 @@ fn at_a_switch_the_body_does_not_jump() {
 }
 
 #[test]
-fn a_hopper_becomes_rigid_in_the_pose_the_gait_table_gave_it() {
-    let mut sim = watched(influence_config());
+fn a_hopper_or_biped_becomes_rigid_in_the_pose_the_gait_table_gave_it() {
+    let config = influence_config();
+    let biped = config.kind_index("biped").unwrap();
+    let mut sim = watched(config);
     sim.run_for(20.0);
     let seen = sim.app.world().resource::<Watch>().seen.clone();
     let ups: Vec<_> = seen
@@ -171,12 +209,18 @@ fn a_hopper_becomes_rigid_in_the_pose_the_gait_table_gave_it() {
         .filter(|o| o.switch.flight_progress.is_some() && (o.switch.from, o.switch.to) == (Lod::Hybrid, Lod::Rigid))
         .collect();
     assert!(ups.len() >= 10, "{} switches up to rigid", ups.len());
+    let bipeds = ups.iter().filter(|o| o.before.kind == biped).count();
+    assert!(bipeds >= 3, "{bipeds} bipeds switched up to rigid");
     for o in ups {
-        // The hybrid's table pose at the end of the tick before, against the bodies' pose
-        // after their first physics step. In flight the body rises or falls at most about
-        // 1.5 m/s, 6 mm in a 240 Hz tick; the leg swings toward its touchdown angle at up to
-        // about 2 degrees a tick (both from the rigid hopper's recorded hops).
-        let (b, a) = (o.before.pose, o.after.pose);
+        // The hybrid's table pose continued one tick by its own motion (from the two ticks
+        // before), against the bodies' pose after their first physics step: the jump a viewer
+        // would see (as at_a_switch_the_body_does_not_jump continues the position). In flight
+        // the body rises or falls at most about 1.5 m/s, 6 mm in a 240 Hz tick; the leg
+        // swings toward its touchdown angle at up to about 2 degrees a tick; a biped's legs
+        // change length by up to 0.22 m in 0.1 s, 9 mm a tick (from the rigid models' recorded
+        // steps): the bounds allow about one tick's motion left unpredicted.
+        let (e, b, a) = (o.earlier.pose, o.before.pose, o.after.pose);
+        let b = continued(e, b);
         let rise = (a.body_height_m - b.body_height_m).abs();
         assert!(
             rise < 0.01,
@@ -190,6 +234,7 @@ fn a_hopper_becomes_rigid_in_the_pose_the_gait_table_gave_it() {
         ] {
             assert!(d < limit, "{:?}: {what} jumped {d} degrees: {b:?} -> {a:?}", o.switch);
         }
+        // Every leg, both of a biped's.
         for (la, lb) in a.legs().iter().zip(b.legs()) {
             for (what, d) in [
                 ("leg forward", degrees(la.forward_rad, lb.forward_rad)),
@@ -280,26 +325,44 @@ fn switching_is_deterministic() {
 
 #[test]
 fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
-    let mut config = influence_config();
-    config.scenario.creatures.retain(|g| g.kind == "hopper");
-    config.scenario.creatures[0].count = 100;
+    // Hoppers and bipeds, at every level (influence switches between rigid and hybrid, and
+    // the camera rule below takes those out of view to the point mass).
+    let mut config = scene(&[("hopper", 70), ("biped", 30)], LevelPolicy::Combined);
     // Small areas, a thin margin and a short dwell: creatures cross boundaries often.
     config.rules.influence.creature_radius_m = 0.8;
     config.rules.influence.puck_radius_m = 4.0;
     config.rules.min_dwell_s = 0.1;
     config.rules.release_margin_m = 0.3;
+    let (hopper, biped) = (
+        config.kind_index("hopper").unwrap(),
+        config.kind_index("biped").unwrap(),
+    );
+    let legs: Vec<usize> = config.kinds.iter().map(|k| k.legs.len()).collect();
     let mut sim = HeadlessSim::new(config);
     let mut baseline = None;
     while sim.clock().seconds() < 600.0 {
         sim.run_for(60.0);
         let world = sim.app.world_mut();
-        let creatures: Vec<Lod> = world
-            .query_filtered::<&Lod, With<Creature>>()
+        let creatures: Vec<(Lod, usize)> = world
+            .query::<(&Lod, &Creature)>()
             .iter(world)
-            .copied()
+            .map(|(l, c)| (*l, c.kind))
             .collect();
         assert_eq!(creatures.len(), 100);
-        let rigid = creatures.iter().filter(|l| **l == Lod::Rigid).count();
+        for (kind, count) in [(hopper, 70), (biped, 30)] {
+            assert_eq!(
+                creatures.iter().filter(|c| c.1 == kind).count(),
+                count,
+                "no creature lost"
+            );
+        }
+        let rigid = creatures.iter().filter(|c| c.0 == Lod::Rigid).count();
+        // A body and two parts a leg.
+        let rigid_parts: usize = creatures
+            .iter()
+            .filter(|c| c.0 == Lod::Rigid)
+            .map(|c| 1 + 2 * legs[c.1])
+            .sum();
         let parts = world.query::<&RigidPart>().iter(world).count();
         let bodies = world.query::<&RigidBody>().iter(world).count();
         let rapier_bodies = world.query::<&RapierRigidBodySet>().single(world).unwrap().bodies.len();
@@ -316,7 +379,7 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
         let entities = world.iter_entities().count();
         assert_eq!(
             parts,
-            3 * rigid,
+            rigid_parts,
             "bodies of rigid creatures at {} s",
             sim.clock().seconds()
         );
@@ -326,11 +389,21 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
         assert_eq!(multibodies, rigid, "one multibody per rigid creature");
         assert_eq!(impulse_joints, 0);
         // Every other entity (creatures, court, rapier's context, the app's own) is fixed.
-        let others = entities - 3 * rigid;
+        let others = entities - rigid_parts;
         assert_eq!(*baseline.get_or_insert(others), others, "entities besides the bodies");
     }
     let summary = sim.summary(0.0);
     eprintln!("soak: {:?} switches, {} falls", summary.switches, summary.falls);
+    // Every level entered, again and again.
+    for level in [Lod::PointMass, Lod::Hybrid, Lod::Rigid] {
+        let into: u64 = summary
+            .switches
+            .directions()
+            .filter(|d| d.1 == level)
+            .map(|d| d.2)
+            .sum();
+        assert!(into >= 10, "{into} switches into {level:?}");
+    }
     assert!(summary.switches.total() >= 10_000, "{:?}", summary.switches);
 }
 
@@ -370,7 +443,8 @@ fn a_margin_at_the_edge_of_the_view_cone_keeps_creatures_there_from_flickering()
     // A flicker is a creature going into view and back out (or out and back in) within a
     // second, two hops.
     let flickers = |margin_deg: f32| {
-        // A scene of its own, so that the shipped scenario's kinds do not change the count.
+        // A scene of its own, of hoppers: with bipeds in it the margin does not yet halve the
+        // flickers (9 without, 10 with; not explained yet).
         let mut config = scene(&[("hopper", 40)], LevelPolicy::Camera);
         config.rules.min_dwell_s = 0.0;
         config.rules.release_margin_m = 0.0;
@@ -382,7 +456,11 @@ fn a_margin_at_the_edge_of_the_view_cone_keeps_creatures_there_from_flickering()
         for o in &sim.app.world().resource::<Watch>().seen {
             let s = o.switch;
             let across_edge = |a: Lod, b: Lod| a.min(b) == Lod::PointMass && a != b;
+            // A collision forcing a creature rigid, and its going back, is not the view's edge.
+            let windowed = |s: &LevelSwitched| s.flight_progress.is_some();
             if let Some(p) = last.get(&s.serial)
+                && windowed(p)
+                && windowed(&s)
                 && across_edge(s.from, s.to)
                 && (p.from, p.to) == (s.to, s.from)
                 && s.at_s - p.at_s < 1.0

@@ -90,8 +90,14 @@ impl Raibert {
             .legs
             .iter()
             .fold(kind.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg);
-        let stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
-        let hop_period_s = stance_s + r.controller.flight_time_s;
+        let mut stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
+        let mut hop_period_s = stance_s + r.controller.flight_time_s;
+        // In flight from the hybrid level, as the entry pose is: the table's rhythm, so the
+        // legs' servos (idle_leg_swap_s) go on where the table's legs were.
+        if kind.gait.is_some() && gait.in_flight && gait.hop_period_s > 0.0 {
+            hop_period_s = gait.hop_period_s;
+            stance_s = gait.stance_fraction * hop_period_s;
+        }
         let last_touchdown_s = now - gait.cycle * hop_period_s;
         Self {
             phase: StancePhase::Flight,
@@ -283,16 +289,28 @@ impl Raibert {
         }
     }
 
-    /// The spring rest length a leg in `role` aims at this tick.
-    fn spring_target(&self, leg: &LegConfig, r: &RigidConfig, role: Role) -> f32 {
+    /// The spring rest length a leg in `role` aims at `now`. With legs in turn, from a lift-off
+    /// the leg that lifted off shortens, and the one that lands next lengthens, over
+    /// `idle_leg_swap_s`: Raibert's leg servo in flight.
+    fn spring_target(&self, leg: &LegConfig, r: &RigidConfig, role: Role, together: bool, now: f32) -> f32 {
+        let c = &r.controller;
+        let swapped = if c.idle_leg_swap_s > 0.0 {
+            ((now - self.last_liftoff_s) / c.idle_leg_swap_s).clamp(0.0, 1.0)
+        } else {
+            1.0
+        };
+        let retracted = |share: f32| (leg.rest_length_m - c.idle_leg_retract_m * share).max(leg.min_length_m);
         match role {
             Role::Stance if self.phase == StancePhase::Thrust => leg.rest_length_m + self.thrust_m,
-            Role::Stance | Role::Landing => leg.rest_length_m,
-            Role::Idle => (leg.rest_length_m - r.controller.idle_leg_retract_m).max(leg.min_length_m),
+            Role::Stance => leg.rest_length_m,
+            Role::Landing if together => leg.rest_length_m,
+            Role::Landing => retracted(1.0 - swapped),
+            Role::Idle => retracted(swapped),
         }
     }
 
-    fn torques(&self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, dt: f32) -> Torques {
+    fn torques(&self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, clock: (f32, f32)) -> Torques {
+        let (now, dt) = clock;
         let c = &r.controller;
         let (legs, together) = (kind.legs.len(), kind.steps_per_stride == 1);
         let mut out = Torques {
@@ -340,7 +358,7 @@ impl Raibert {
                     // A hip off the body's centre: the leg's thrust there would roll and pitch
                     // the body each step, so the hip cancels that moment about the centre (not
                     // its yaw: a point foot has no grip to twist on).
-                    let thrust = spring_force(sensed, leg, self.spring_target(leg, r, Role::Stance));
+                    let thrust = spring_force(sensed, leg, self.spring_target(leg, r, Role::Stance, together, now));
                     let moment = sensed.hip.cross(sensed.axis * thrust) * Vec3::new(1.0, 0.0, 1.0);
                     stance_body += twist + moment;
                     out.legs[i] = -attitude_level(s, c) / stance_legs - twist - moment;
@@ -426,7 +444,7 @@ pub(super) fn control_legs(
         raibert.command += step;
         let command = raibert.command;
         raibert.update_phase(&sensed, kind, r, command, now);
-        let torques = raibert.torques(&sensed, kind, r, command, clock.dt);
+        let torques = raibert.torques(&sensed, kind, r, command, (now, clock.dt));
         let shove_force = shove.map_or(Vec3::ZERO, |s| {
             commands.entity(entity).remove::<Shove>();
             s.0 / clock.dt
@@ -441,7 +459,8 @@ pub(super) fn control_legs(
         for (i, (leg_bodies, leg)) in bodies.legs.iter().zip(&kind.legs).enumerate() {
             let role = raibert.role(i, kind.legs.len(), together);
             let sensed_leg = &sensed.legs[i];
-            let push = sensed_leg.axis * spring_force(sensed_leg, leg, raibert.spring_target(leg, r, role));
+            let target = raibert.spring_target(leg, r, role, together, now);
+            let push = sensed_leg.axis * spring_force(sensed_leg, leg, target);
             for (part, force, torque) in [
                 (leg_bodies.upper, -push, torques.legs[i]),
                 (leg_bodies.lower, push, Vec3::ZERO),
