@@ -5,7 +5,9 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use simlod::config::{CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_file};
+use simlod::config::{
+    CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_costs, load_file,
+};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::{Counts, Key, Summary};
@@ -269,6 +271,7 @@ impl ScenarioArgs {
             SimConfig::load_without_table_of(&self.scenario, &self.assets, without).map_err(|e| e.to_string())?;
         if let Some(rules) = &self.rules {
             config.rules = load_file(rules).map_err(|e| e.to_string())?;
+            config.costs = load_costs(&self.assets, rules, &config.rules).map_err(|e| e.to_string())?;
         }
         if let Some(seed) = self.seed {
             config.scenario.seed = seed;
@@ -342,8 +345,48 @@ struct BenchArgs {
     #[arg(long)]
     quick: bool,
     /// Only this level (no cost ratios, no game).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, conflicts_with = "calibrate")]
     level: Option<Lod>,
+    /// Measure the budget policy's cost model (each kind's levels and its switch into rigid)
+    /// and write it to the file the level rules name (`budget.cost_model`), or to `--out`.
+    #[arg(long)]
+    calibrate: bool,
+    /// Where `--calibrate` writes the cost model.
+    #[arg(long, requires = "calibrate")]
+    out: Option<PathBuf>,
+}
+
+impl BenchArgs {
+    fn calibrate(&self, config: &SimConfig) -> Result<(), String> {
+        let out = self
+            .out
+            .clone()
+            .unwrap_or_else(|| self.scenario.assets.join(&config.rules.budget.cost_model));
+        let model = bench::calibrate(config, self.quick);
+        let command = format!(
+            "simlod bench --calibrate --scenario {}{}",
+            self.scenario.scenario.display(),
+            if self.quick { " --quick" } else { "" }
+        );
+        if let Some(dir) = out.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        }
+        std::fs::write(&out, bench::costs_file_text(&model, &command))
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        if self.json {
+            println!("{}", serde_json::to_string(&model).expect("a cost model serialises"));
+        } else {
+            println!("wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):", out.display());
+            for k in &model.kinds {
+                let c = &k.costs;
+                println!(
+                    "  {:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
+                    k.kind, c.point_mass_us_per_frame, c.hybrid_us_per_frame, c.rigid_us_per_frame, c.switch_to_rigid_us
+                );
+            }
+        }
+        Ok(())
+    }
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
@@ -398,6 +441,20 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         .chain([format!("total {}", s.switches.total())])
         .collect();
     println!("level switches: {}", switches.join(", "));
+    if let Some(b) = &s.budget {
+        let over = if b.decisions_over_budget == 0 {
+            "never over it".to_owned()
+        } else {
+            format!(
+                "the budget was exceeded at {} of {} decisions (even the cheapest levels did not fit)",
+                b.decisions_over_budget, b.decisions
+            )
+        };
+        println!(
+            "frame budget {} ms of simulation per 1/30 s: predicted {:.3} ms on average, {:.3} ms at most; {over}",
+            b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max
+        );
+    }
     for p in &s.pops {
         println!(
             "  pops {}->{}{}: as drawn {:.2} cm, {:.2} deg, {:.3} m/s; models alone {:.1} cm, {:.1} deg (largest of {})",
@@ -436,10 +493,14 @@ fn main() -> ExitCode {
             }
         }),
         Some(Command::RecordGait(args)) => args.run(),
-        Some(Command::Bench(args)) => args
-            .scenario
-            .load()
-            .map(|config| bench::run(&config, args.quick, args.json, args.level)),
+        Some(Command::Bench(args)) => args.scenario.load().and_then(|config| {
+            if args.calibrate {
+                args.calibrate(&config)
+            } else {
+                bench::run(&config, args.quick, args.json, args.level);
+                Ok(())
+            }
+        }),
         Some(Command::Experiment(ExperimentArgs { which })) => match which {
             ExperimentKind::StepResponse(run) => run.run("step-response"),
             ExperimentKind::Table1(run) => run.run("table1"),
