@@ -301,7 +301,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
         let switch_us = if levels.contains(&Lod::Rigid) {
             median(
                 (0..runs)
-                    .map(|_| switch_cost_us(&alone, 2 * rigid_count, levels[levels.len() - 2], frames))
+                    .map(|_| switch_cost_us(&alone, 4 * rigid_count, levels[levels.len() - 2], us))
                     .collect(),
             )
         } else {
@@ -330,45 +330,23 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     }
 }
 
-/// Microseconds per switch into the rigid level: `count` creatures at `below` are all asked
-/// to go rigid; each frame until they are (each in its flight window) is timed, less what the
-/// frame would cost with its creatures at their levels, taken from the same world's median
-/// frame before the switches (all at `below`) and after them (all rigid), so that the machine's
-/// load of the moment cancels; the excess is divided by the switches.
-fn switch_cost_us(config: &SimConfig, count: u32, below: Lod, frames: usize) -> f64 {
-    let policy = match below {
+/// Microseconds per switch into the rigid level (building a creature's bodies, and rapier
+/// taking them in): a world of `count` creatures built and run for one frame all rigid, less
+/// the same world all at `below`, less the difference of their levels' frames (`us`, per
+/// level), per creature. Building the world costs both the same; the rigid one enters every
+/// creature's level the way a switch does (the level's observers, then rapier's first step).
+fn switch_cost_us(config: &SimConfig, count: u32, below: Lod, us: [f64; 3]) -> f64 {
+    let start_s = |policy: LevelPolicy| {
+        let start = Instant::now();
+        HeadlessSim::new(scaled(config, count, policy)).advance_frame();
+        start.elapsed().as_secs_f64()
+    };
+    let cheap = match below {
         Lod::Hybrid => LevelPolicy::AllHybrid,
         _ => LevelPolicy::AllPointMass,
     };
-    let mut sim = HeadlessSim::new(scaled(config, count, policy));
-    let before_s = median_frame_seconds_of(&mut sim, frames, frames);
-    sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = LevelPolicy::AllRigid;
-    let rigid_now = |sim: &mut HeadlessSim| {
-        let world = sim.app.world_mut();
-        world.query::<&Lod>().iter(world).filter(|&&l| l == Lod::Rigid).count() as u64
-    };
-    // (frame seconds, rigid creatures at its end) of each frame of the change.
-    let mut change = Vec::new();
-    for _ in 0..90 {
-        let start = Instant::now();
-        sim.advance_frame();
-        change.push((start.elapsed().as_secs_f64(), rigid_now(&mut sim)));
-        if change.last().is_some_and(|&(_, n)| n == u64::from(count)) {
-            break;
-        }
-    }
-    let after_s = median_frame_seconds_of(&mut sim, 0, frames);
-    // Those that switched in a frame are counted rigid for all of it: if anything, the excess
-    // comes out too small.
-    let excess_s: f64 = change
-        .iter()
-        .map(|&(frame_s, rigid)| {
-            let share = rigid as f64 / f64::from(count);
-            frame_s - (before_s * (1.0 - share) + after_s * share)
-        })
-        .sum();
-    let switched = change.last().map_or(0, |&(_, n)| n);
-    (excess_s * 1e6 / switched.max(1) as f64).max(0.0)
+    let (cheap_s, rigid_s) = (start_s(cheap), start_s(LevelPolicy::AllRigid));
+    ((rigid_s - cheap_s) * 1e6 / f64::from(count) - (us[2] - us[below as usize])).max(0.0)
 }
 
 /// The cost model as its file says it, with the command that measured it.
