@@ -154,6 +154,9 @@ enum ExperimentKind {
     Fig9(ExperimentRun),
     /// Figure 10: the change in creatures that hit the puck or a wall, against all rigid.
     Fig10(ExperimentRun),
+    /// Beyond the paper: the budget policy against fixed radii on figure 10's axes, and the
+    /// frame times of a crowded game.
+    Budget(ExperimentRun),
     /// Every experiment, into one folder.
     All(ExperimentRun),
     /// Combine fig10 shards (`--shard K/N` runs) into the files of one unsharded run.
@@ -508,6 +511,7 @@ fn main() -> ExitCode {
             ExperimentKind::Fig8(run) => run.run("fig8"),
             ExperimentKind::Fig9(run) => run.run("fig9"),
             ExperimentKind::Fig10(run) => run.run("fig10"),
+            ExperimentKind::Budget(run) => run.run("budget"),
             ExperimentKind::All(run) => run.run("all"),
             ExperimentKind::Merge { dirs, out } => {
                 experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))
