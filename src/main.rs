@@ -379,12 +379,19 @@ impl BenchArgs {
         if self.json {
             println!("{}", serde_json::to_string(&model).expect("a cost model serialises"));
         } else {
-            println!("wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):", out.display());
+            println!(
+                "wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):",
+                out.display()
+            );
             for k in &model.kinds {
                 let c = &k.costs;
                 println!(
                     "  {:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
-                    k.kind, c.point_mass_us_per_frame, c.hybrid_us_per_frame, c.rigid_us_per_frame, c.switch_to_rigid_us
+                    k.kind,
+                    c.point_mass_us_per_frame,
+                    c.hybrid_us_per_frame,
+                    c.rigid_us_per_frame,
+                    c.switch_to_rigid_us
                 );
             }
         }

@@ -44,7 +44,11 @@ pub struct BudgetSettings {
 
 impl Validate for BudgetSettings {
     fn validate(&self, v: &mut Validator) {
-        v.require(!self.budgets_ms.is_empty(), "budgets_ms", "must list at least one budget");
+        v.require(
+            !self.budgets_ms.is_empty(),
+            "budgets_ms",
+            "must list at least one budget",
+        );
         for (i, b) in self.budgets_ms.iter().enumerate() {
             v.range(&format!("budgets_ms[{i}]"), *b, 0.0, 10_000.0);
         }
@@ -88,7 +92,8 @@ impl Setting {
     }
 }
 
-const HEADER: &str = "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid";
+const HEADER: &str =
+    "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid";
 
 /// One trial under one setting, beside the identical trial all rigid.
 struct Row {
@@ -175,7 +180,10 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
             let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
             let mean_difference = mean(&|r| r.difference());
             let var = if at.len() > 1 {
-                at.iter().map(|r| (r.difference() - mean_difference).powi(2)).sum::<f64>() / (n - 1.0)
+                at.iter()
+                    .map(|r| (r.difference() - mean_difference).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0)
             } else {
                 0.0
             };
@@ -247,7 +255,8 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         load_file(&options.assets.join(name)).map_err(|e| format!("{e} (named by {}: field `{field}`)", file.display()))
     };
     let budget_rules = read("budget_rules", &s.budget_rules)?;
-    let costs = load_costs(&options.assets, &options.assets.join(&s.budget_rules), &budget_rules).map_err(|e| e.to_string())?;
+    let costs =
+        load_costs(&options.assets, &options.assets.join(&s.budget_rules), &budget_rules).map_err(|e| e.to_string())?;
     let rules = Rules {
         fixed: read("fixed_rules", &s.fixed_rules)?,
         budget: (budget_rules, costs),
@@ -277,7 +286,13 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     finish(&rows, &points, &crowd, &s, options)
 }
 
-fn finish(rows: &[Row], points: &[Point], crowd: &[Crowd], s: &BudgetSettings, options: &Options) -> Result<String, String> {
+fn finish(
+    rows: &[Row],
+    points: &[Point],
+    crowd: &[Crowd],
+    s: &BudgetSettings,
+    options: &Options,
+) -> Result<String, String> {
     let out = &options.out;
     let mut csv = format!("{HEADER}\n");
     for r in rows {
@@ -307,7 +322,12 @@ fn finish(rows: &[Row], points: &[Point], crowd: &[Crowd], s: &BudgetSettings, o
     };
     let mut trace_series = Vec::new();
     for (i, c) in crowd.iter().enumerate() {
-        let points = c.frame_ms.iter().enumerate().map(|(f, &ms)| (f as f64 / 30.0, ms)).collect();
+        let points = c
+            .frame_ms
+            .iter()
+            .enumerate()
+            .map(|(f, &ms)| (f as f64 / 30.0, ms))
+            .collect();
         trace_series.push(Series::new(
             format!("{} (slowest {:.0} ms)", c.policy, c.slowest_frame_ms),
             points,

@@ -14,8 +14,8 @@ use super::reload::Problems;
 use super::scene::{ColourByLevel, srgb};
 use crate::SimClock;
 use crate::config::SimConfig;
-use crate::lod::{BudgetTally, LevelPolicy, Lod};
 use crate::lod::PopTally;
+use crate::lod::{BudgetTally, LevelPolicy, Lod};
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -69,7 +69,9 @@ fn stop_timing(settings: Res<GameSettings>, clock: Res<SimClock>, mut timing: Re
     let ease = 1.0 - (-dt / settings.hud.smoothing_s).exp();
     let sim_ms = start.elapsed().as_secs_f32() * 1000.0;
     timing.sim_ms_per_frame += (sim_ms - timing.sim_ms_per_frame) * ease;
-    let ticks = clock.tick.saturating_sub(std::mem::replace(&mut timing.last_tick, clock.tick));
+    let ticks = clock
+        .tick
+        .saturating_sub(std::mem::replace(&mut timing.last_tick, clock.tick));
     if ticks > 0 {
         let per_decision = sim_ms * clock.ticks_per_decision as f32 / ticks as f32;
         timing.sim_ms_per_decision += (per_decision - timing.sim_ms_per_decision) * ease;
@@ -272,7 +274,13 @@ fn show_hud(
         let (shown, wanted) = match which {
             HudText::Stats => (
                 true,
-                stats_text(&round, &timing, &counts.0, (&config, &budget), show_pops.0.then_some(&*pops)),
+                stats_text(
+                    &round,
+                    &timing,
+                    &counts.0,
+                    (&config, &budget),
+                    show_pops.0.then_some(&*pops),
+                ),
             ),
             HudText::Level(level) => {
                 let n = counts.0.levels[*level];

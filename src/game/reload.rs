@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
 use crate::config::{
-    ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file, load_costs,
-    resolve_reference,
+    ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file,
+    load_costs, resolve_reference,
 };
 use crate::gait::GaitTable;
 

@@ -231,7 +231,9 @@ impl Scene<'_> {
     /// earliest `t_worst` away, is worth.
     fn urgency(&self, t_course: f32, t_worst: f32) -> f32 {
         let h = self.rules.contact_horizon_s;
-        (-t_course / h).exp().max(self.rules.worst_case_share * (-t_worst / h).exp())
+        (-t_course / h)
+            .exp()
+            .max(self.rules.worst_case_share * (-t_worst / h).exp())
     }
 
     /// Benefit of the rigid level from how soon a contact could come.
@@ -304,7 +306,17 @@ impl Scene<'_> {
     }
 }
 
-type Creatures<'w, 's> = Query<'w, 's, (Entity, &'static Creature, &'static Lod, &'static PlanarState, &'static mut LevelChoice)>;
+type Creatures<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Creature,
+        &'static Lod,
+        &'static PlanarState,
+        &'static mut LevelChoice,
+    ),
+>;
 
 /// The allocation for every creature now, in the order of their serials.
 fn decide(
@@ -319,7 +331,7 @@ fn decide(
     rows.sort_unstable_by_key(|r| r.1.serial);
     let candidates: Vec<Candidate> = rows
         .iter()
-        .map(|&(entity, c, &lod, s, ref choice)| {
+        .map(|&(entity, c, &lod, s, choice)| {
             let kind = &kinds[c.kind];
             let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
             Candidate {
@@ -413,7 +425,9 @@ fn start_by_budget(
     let scene = scene(&config, &kinds, &puck, &court, &grid, &camera);
     let (entities, allocation) = decide(now, &config, &kinds, &scene, &creatures);
     for (&entity, &level) in entities.iter().zip(&allocation.levels) {
-        let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else { continue };
+        let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
+            continue;
+        };
         if level != lod
             && let Ok((mut gait, mut pose)) = gaits.get_mut(entity)
         {
@@ -464,8 +478,14 @@ mod tests {
         // 10 m apart, closing at 2 m/s, touching at 1 m: 4.5 s.
         let t = time_to_contact(Vec2::new(10.0, 0.0), Vec2::new(-2.0, 0.0), 1.0);
         assert!((t - 4.5).abs() < 1e-5, "{t}");
-        assert_eq!(time_to_contact(Vec2::new(10.0, 0.0), Vec2::new(2.0, 0.0), 1.0), f32::INFINITY);
-        assert_eq!(time_to_contact(Vec2::new(10.0, 5.0), Vec2::new(-2.0, 0.0), 1.0), f32::INFINITY);
+        assert_eq!(
+            time_to_contact(Vec2::new(10.0, 0.0), Vec2::new(2.0, 0.0), 1.0),
+            f32::INFINITY
+        );
+        assert_eq!(
+            time_to_contact(Vec2::new(10.0, 5.0), Vec2::new(-2.0, 0.0), 1.0),
+            f32::INFINITY
+        );
         assert_eq!(time_to_contact(Vec2::new(0.5, 0.0), Vec2::ZERO, 1.0), 0.0);
     }
 
@@ -474,7 +494,10 @@ mod tests {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Room for two going rigid and three hybrids (2 x (100 + 50) + 3 x 2 = 306).
         let a = allocate(&cs, 310.0, 0.0);
-        assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]);
+        assert_eq!(
+            a.levels,
+            [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]
+        );
         assert!(a.predicted_us <= 310.0 && !a.exceeded, "{a:?}");
     }
 

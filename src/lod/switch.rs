@@ -10,9 +10,9 @@
 
 use bevy::prelude::*;
 
-use super::{LevelPolicy, Lod};
 use super::blend::{Drawn, DrawnBefore, SwitchBlend, SwitchProbe};
 use super::select::{LevelChoice, levels_may_change};
+use super::{LevelPolicy, Lod};
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::outcome::{CollisionRecord, Counts, SwitchCounts};

@@ -23,7 +23,9 @@ use crate::config::SimConfig;
 use crate::creature::{
     Creature, GaitPhase, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
 };
-use crate::lod::{AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, Lod, PopSummary, PopTally, SwitchTally};
+use crate::lod::{
+    AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, Lod, PopSummary, PopTally, SwitchTally,
+};
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart, WorldRng};
 

@@ -87,7 +87,10 @@ fn the_creature_about_to_be_hit_is_rigid_before_the_one_far_from_everything() {
         .max_by(|a, b| a.distance(puck.position).total_cmp(&b.distance(puck.position)))
         .unwrap();
     assert!(far.distance(puck.position) > 12.0 && (half - far.abs()).min_element() > 8.0);
-    assert!((half - ahead.abs()).min_element() > 1.0, "the puck is too near a wall: {puck:?}");
+    assert!(
+        (half - ahead.abs()).min_element() > 1.0,
+        "the puck is too near a wall: {puck:?}"
+    );
     let mut serials = Vec::new();
     for (c, mut s) in world.query::<(&Creature, &mut PlanarState)>().iter_mut(world) {
         s.position = if serials.is_empty() { ahead } else { far };
