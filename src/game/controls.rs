@@ -273,11 +273,11 @@ mod tests {
                 app.world().resource::<BaseConfig>().scenario.level_policy,
             )
         };
-        assert_eq!(policies(&app), (LevelPolicy::AllPointMass, LevelPolicy::AllPointMass));
+        assert_eq!(policies(&app), (LevelPolicy::Budget, LevelPolicy::Budget));
         assert_eq!(serials(&mut app), before, "the same creatures: no new round");
         press(&mut app, KeyCode::KeyL);
-        assert_eq!(policies(&app), (LevelPolicy::AllHybrid, LevelPolicy::AllHybrid));
-        assert!(app.world().resource::<Notice>().text.contains("all-hybrid"));
+        assert_eq!(policies(&app), (LevelPolicy::AllPointMass, LevelPolicy::AllPointMass));
+        assert!(app.world().resource::<Notice>().text.contains("all-point-mass"));
     }
 
     #[test]

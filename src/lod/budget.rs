@@ -15,6 +15,7 @@
 //! level, its last chosen level counts `hysteresis` more, and the switch itself still waits
 //! for the flight window (`switch.rs`). No clock is read: the same files give the same run.
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use serde::Serialize;
 
@@ -374,23 +375,45 @@ fn scene<'a>(
     }
 }
 
+/// What a decision reads besides the creatures.
+#[derive(SystemParam)]
+struct Inputs<'w> {
+    clock: Res<'w, SimClock>,
+    config: Res<'w, SimConfig>,
+    kinds: Res<'w, KindTable>,
+    puck: Res<'w, PuckState>,
+    court: Res<'w, Court>,
+    grid: Res<'w, NeighbourGrid>,
+    camera: Res<'w, SimCamera>,
+}
+
+impl Inputs<'_> {
+    /// The allocation for every creature now, in the order of their serials.
+    fn decide(&self, creatures: &Creatures) -> (Vec<Entity>, Allocation) {
+        let scene = scene(
+            &self.config,
+            &self.kinds,
+            &self.puck,
+            &self.court,
+            &self.grid,
+            &self.camera,
+        );
+        decide(
+            self.clock.seconds() as f32,
+            &self.config,
+            &self.kinds,
+            &scene,
+            creatures,
+        )
+    }
+}
+
 /// At each decision, under the budget policy: every creature's wanted level.
-fn choose_by_budget(
-    clock: Res<SimClock>,
-    config: Res<SimConfig>,
-    kinds: Res<KindTable>,
-    puck: Res<PuckState>,
-    court: Res<Court>,
-    grid: Res<NeighbourGrid>,
-    camera: Res<SimCamera>,
-    mut tally: ResMut<BudgetTally>,
-    mut creatures: Creatures,
-) {
-    if !clock.is_decision_tick() {
+fn choose_by_budget(inputs: Inputs, mut tally: ResMut<BudgetTally>, mut creatures: Creatures) {
+    if !inputs.clock.is_decision_tick() {
         return;
     }
-    let scene = scene(&config, &kinds, &puck, &court, &grid, &camera);
-    let (entities, allocation) = decide(clock.seconds() as f32, &config, &kinds, &scene, &creatures);
+    let (entities, allocation) = inputs.decide(&creatures);
     tally.record(&allocation);
     for (entity, &level) in entities.iter().zip(&allocation.levels) {
         if let Ok((.., mut choice)) = creatures.get_mut(*entity)
@@ -403,27 +426,19 @@ fn choose_by_budget(
 
 /// A new world under the budget policy: its creatures, placed at the cheapest level, start at
 /// the levels the budget gives them (in that level's rhythm and pose).
-#[allow(clippy::too_many_arguments)]
 fn start_by_budget(
     mut commands: Commands,
-    clock: Res<SimClock>,
-    config: Res<SimConfig>,
-    kinds: Res<KindTable>,
-    puck: Res<PuckState>,
-    court: Res<Court>,
-    grid: Res<NeighbourGrid>,
-    camera: Res<SimCamera>,
+    inputs: Inputs,
     mut tally: ResMut<BudgetTally>,
     mut creatures: Creatures,
     mut gaits: Query<(&mut GaitPhase, &mut GaitPose)>,
 ) {
     *tally = BudgetTally::default();
-    if config.scenario.level_policy != LevelPolicy::Budget {
+    if inputs.config.scenario.level_policy != LevelPolicy::Budget {
         return;
     }
-    let now = clock.seconds() as f32;
-    let scene = scene(&config, &kinds, &puck, &court, &grid, &camera);
-    let (entities, allocation) = decide(now, &config, &kinds, &scene, &creatures);
+    let now = inputs.clock.seconds() as f32;
+    let (entities, allocation) = inputs.decide(&creatures);
     for (&entity, &level) in entities.iter().zip(&allocation.levels) {
         let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
             continue;
@@ -431,7 +446,7 @@ fn start_by_budget(
         if level != lod
             && let Ok((mut gait, mut pose)) = gaits.get_mut(entity)
         {
-            (*gait, *pose) = starting_gait(level, &kinds[c.kind], gait.cycle, now);
+            (*gait, *pose) = starting_gait(level, &inputs.kinds[c.kind], gait.cycle, now);
             commands.entity(entity).insert(level);
         }
         choice.wanted = level;

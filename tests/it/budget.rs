@@ -147,3 +147,25 @@ fn a_budget_too_small_for_the_cheapest_levels_gives_them_and_says_it_was_exceede
     assert_eq!(budget.decisions_over_budget, budget.decisions);
     assert!(budget.predicted_ms_max >= 0.02 - 1e-6, "{budget:?}");
 }
+
+#[test]
+fn a_bad_cost_model_or_a_missing_one_is_refused_naming_the_file_and_the_field() {
+    use crate::assets::{assets_with, edited};
+    let load = |root: std::path::PathBuf| SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap_err();
+    let negative = edited("costs.ron", "rigid_us_per_frame: ", "rigid_us_per_frame: -");
+    let err = load(assets_with("budget_negative_cost", "costs.ron", &negative));
+    let text = err.to_string();
+    assert!(err.file.ends_with("costs.ron"), "{text}");
+    assert!(
+        text.contains("`kinds[0].costs.rigid_us_per_frame`") && text.contains("got -"),
+        "{text}"
+    );
+    let gone = edited("rules/levels.ron", "\"costs.ron\"", "\"gone.ron\"");
+    let err = load(assets_with("budget_missing_costs", "rules/levels.ron", &gone));
+    let text = err.to_string();
+    assert!(err.file.ends_with("rules/levels.ron"), "{text}");
+    assert!(
+        text.contains("`budget.cost_model`") && text.contains("gone.ron"),
+        "{text}"
+    );
+}
