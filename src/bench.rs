@@ -9,7 +9,7 @@
 use serde::Serialize;
 use std::time::Instant;
 
-use crate::config::SimConfig;
+use crate::config::{CostModel, KindCosts, LevelCosts, SimConfig};
 use crate::creature::KindTable;
 use crate::headless::HeadlessSim;
 use crate::lod::{LevelPolicy, Lod};
@@ -266,4 +266,95 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
             rigid / influence
         );
     }
+}
+
+/// `simlod bench --calibrate`: the budget policy's cost model from measured medians. For each
+/// kind of the scenario alone, in a court scaled to its density: each level's median frame
+/// divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so one thread, as in
+/// a game), and the switch into the rigid level: the frames in which a crowd of them goes
+/// rigid, less what their levels cost in those frames, per switch. A kind without an entry is
+/// predicted at the dearest calibrated kind's costs.
+pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
+    let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
+    let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
+    let kinds = KindTable::of(config);
+    let mut entries = Vec::new();
+    for def in &config.kinds {
+        let alone = crate::experiments::only_kind(config, &def.name);
+        let levels = &kinds[config.kind_index(&def.name).expect("a kind of the config")].levels;
+        let mut us = [0.0f64; 3];
+        for &level in levels {
+            let (policy, count) = match level {
+                Lod::PointMass => (LevelPolicy::AllPointMass, cheap_count),
+                Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
+                Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
+            };
+            let frame_s = median_of_runs(&scaled(&alone, count, policy), runs, warmup, frames);
+            us[level as usize] = frame_s * 1e6 / f64::from(count);
+        }
+        // A kind without a level is predicted at the next cheaper level it has.
+        for l in 1..3 {
+            if !levels.contains(&Lod::ALL[l]) {
+                us[l] = us[l - 1];
+            }
+        }
+        let switch_us = if levels.contains(&Lod::Rigid) {
+            median(
+                (0..runs)
+                    .map(|_| switch_cost_us(&alone, 4 * rigid_count, levels[levels.len() - 2]))
+                    .collect(),
+            )
+        } else {
+            0.0
+        };
+        entries.push(KindCosts {
+            kind: def.name.clone(),
+            costs: LevelCosts {
+                point_mass_us_per_frame: us[0] as f32,
+                hybrid_us_per_frame: us[1] as f32,
+                rigid_us_per_frame: us[2] as f32,
+                switch_to_rigid_us: switch_us as f32,
+            },
+        });
+    }
+    let dearest = |f: fn(&LevelCosts) -> f32| entries.iter().map(|k| f(&k.costs)).fold(0.0, f32::max);
+    let other_kinds = LevelCosts {
+        point_mass_us_per_frame: dearest(|c| c.point_mass_us_per_frame),
+        hybrid_us_per_frame: dearest(|c| c.hybrid_us_per_frame),
+        rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
+        switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
+    };
+    CostModel {
+        kinds: entries,
+        other_kinds,
+    }
+}
+
+/// Microseconds per switch into the rigid level (building a creature's bodies): a world of
+/// `count` creatures built all rigid, less the same world built at `below`, per creature.
+/// Building the rest of the world costs both the same; the rigid one enters every creature's
+/// level the way a switch does (the level's observers). Rapier's taking the bodies into its
+/// world in the next step is not in it: a first step of standing creatures costs less than a
+/// steady one, which hides it in the noise of a shared machine.
+fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
+    let build_s = |policy: LevelPolicy| {
+        let start = Instant::now();
+        drop(HeadlessSim::new(scaled(config, count, policy)));
+        start.elapsed().as_secs_f64()
+    };
+    let cheap = match below {
+        Lod::Hybrid => LevelPolicy::AllHybrid,
+        _ => LevelPolicy::AllPointMass,
+    };
+    let (cheap_s, rigid_s) = (build_s(cheap), build_s(LevelPolicy::AllRigid));
+    ((rigid_s - cheap_s) * 1e6 / f64::from(count)).max(0.0)
+}
+
+/// The cost model as its file says it, with the command that measured it.
+pub fn costs_file_text(model: &CostModel, command: &str) -> String {
+    let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
+    let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
+    format!(
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, and of a switch into the rigid level, in microseconds (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+    )
 }

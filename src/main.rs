@@ -5,7 +5,9 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use simlod::config::{CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_file};
+use simlod::config::{
+    CreatureDef, CreatureGroup, MAX_DURATION_S, SimConfig, Validate, Validator, load_costs, load_file,
+};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::{Counts, Key, Summary};
@@ -154,6 +156,9 @@ enum ExperimentKind {
     Fig9(ExperimentRun),
     /// Figure 10: the change in creatures that hit the puck or a wall, against all rigid.
     Fig10(ExperimentRun),
+    /// Beyond the paper: the budget policy against fixed radii on figure 10's axes, and the
+    /// frame times of a crowded game.
+    Budget(ExperimentRun),
     /// Every experiment, into one folder.
     All(ExperimentRun),
     /// Combine fig10 shards (`--shard K/N` runs) into the files of one unsharded run.
@@ -271,6 +276,7 @@ impl ScenarioArgs {
             SimConfig::load_without_table_of(&self.scenario, &self.assets, without).map_err(|e| e.to_string())?;
         if let Some(rules) = &self.rules {
             config.rules = load_file(rules).map_err(|e| e.to_string())?;
+            config.costs = load_costs(&self.assets, rules, &config.rules).map_err(|e| e.to_string())?;
         }
         if let Some(seed) = self.seed {
             config.scenario.seed = seed;
@@ -344,11 +350,18 @@ struct BenchArgs {
     #[arg(long)]
     quick: bool,
     /// Only this level (no cost ratios, no game).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, conflicts_with = "calibrate")]
     level: Option<Lod>,
     /// Only the scenario's creatures of this kind (for example `biped`): its cost at each level.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "calibrate")]
     kind: Option<String>,
+    /// Measure the budget policy's cost model (each kind's levels and its switch into rigid)
+    /// and write it to the file the level rules name (`budget.cost_model`), or to `--out`.
+    #[arg(long)]
+    calibrate: bool,
+    /// Where `--calibrate` writes the cost model.
+    #[arg(long, requires = "calibrate")]
+    out: Option<PathBuf>,
 }
 
 impl BenchArgs {
@@ -364,7 +377,48 @@ impl BenchArgs {
                 ));
             }
         }
+        if self.calibrate {
+            return self.calibrate(&config);
+        }
         bench::run(&config, self.quick, self.json, self.level);
+        Ok(())
+    }
+
+    fn calibrate(&self, config: &SimConfig) -> Result<(), String> {
+        let out = self
+            .out
+            .clone()
+            .unwrap_or_else(|| self.scenario.assets.join(&config.rules.budget.cost_model));
+        let model = bench::calibrate(config, self.quick);
+        let command = format!(
+            "simlod bench --calibrate --scenario {}{}",
+            self.scenario.scenario.display(),
+            if self.quick { " --quick" } else { "" }
+        );
+        if let Some(dir) = out.parent() {
+            std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+        }
+        std::fs::write(&out, bench::costs_file_text(&model, &command))
+            .map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        if self.json {
+            println!("{}", serde_json::to_string(&model).expect("a cost model serialises"));
+        } else {
+            println!(
+                "wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):",
+                out.display()
+            );
+            for k in &model.kinds {
+                let c = &k.costs;
+                println!(
+                    "  {:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
+                    k.kind,
+                    c.point_mass_us_per_frame,
+                    c.hybrid_us_per_frame,
+                    c.rigid_us_per_frame,
+                    c.switch_to_rigid_us
+                );
+            }
+        }
         Ok(())
     }
 }
@@ -421,6 +475,20 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         .chain([format!("total {}", s.switches.total())])
         .collect();
     println!("level switches: {}", switches.join(", "));
+    if let Some(b) = &s.budget {
+        let over = if b.decisions_over_budget == 0 {
+            "never over it".to_owned()
+        } else {
+            format!(
+                "the budget was exceeded at {} of {} decisions (even the cheapest levels did not fit)",
+                b.decisions_over_budget, b.decisions
+            )
+        };
+        println!(
+            "frame budget {} ms of simulation per 1/30 s: predicted {:.3} ms on average, {:.3} ms at most; {over}",
+            b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max
+        );
+    }
     for p in &s.pops {
         println!(
             "  pops {}->{}{}: as drawn {:.2} cm, {:.2} deg, {:.3} m/s; models alone {:.1} cm, {:.1} deg (largest of {})",
@@ -467,6 +535,7 @@ fn main() -> ExitCode {
             ExperimentKind::Fig8(run) => run.run("fig8"),
             ExperimentKind::Fig9(run) => run.run("fig9"),
             ExperimentKind::Fig10(run) => run.run("fig10"),
+            ExperimentKind::Budget(run) => run.run("budget"),
             ExperimentKind::All(run) => run.run("all"),
             ExperimentKind::Merge { dirs, out } => {
                 experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))

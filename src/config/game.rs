@@ -112,6 +112,8 @@ pub struct HudConfig {
     pub smoothing_s: f32,
     /// One press of `[` `]` or `-` `=` changes a radius of influence by this much.
     pub radius_step_m: f32,
+    /// One press of `9` `0` changes the budget policy's frame budget by this much.
+    pub budget_step_ms: f32,
 }
 
 /// How a creature is drawn from its body size in its creature file.
@@ -205,6 +207,7 @@ impl Validate for GameConfig {
             v.within("banner_font_size_px", h.banner_font_size_px, 6.0, 400.0);
             v.range("smoothing_s", h.smoothing_s, 0.01, 60.0);
             v.within("radius_step_m", h.radius_step_m, 0.1, 10.0);
+            v.range("budget_step_ms", h.budget_step_ms, 0.01, 100.0);
         });
         let k = &self.creature_look;
         v.nested("creature_look", |v| {

@@ -5,6 +5,7 @@
 //! hot reload) and plain file paths (the headless CLI and the tests).
 
 mod arena;
+mod costs;
 mod creature;
 mod game;
 mod loader;
@@ -13,12 +14,13 @@ mod scenario;
 mod validate;
 
 pub use arena::{ArenaConfig, PuckConfig};
+pub use costs::{CostModel, KindCosts, LevelCosts};
 pub use creature::{
     BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, Stance, SteeringConfig,
 };
 pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
-pub use rules::{CameraRules, InfluenceRules, LevelRules};
+pub use rules::{BudgetRules, CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, MAX_CREATURES, MAX_DURATION_S, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator, number};
 
@@ -37,6 +39,8 @@ pub struct SimConfig {
     /// Each kind's gait table, if it has one (same index as `kinds`).
     pub gaits: Vec<Option<GaitTable>>,
     pub rules: LevelRules,
+    /// The budget policy's cost model (the file the rules' `budget.cost_model` names).
+    pub costs: CostModel,
 }
 
 impl SimConfig {
@@ -57,13 +61,14 @@ impl SimConfig {
     ) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena = load_reference(assets_root, scenario_path, "arena", &scenario.arena)?;
-        let rules = load_reference(assets_root, scenario_path, "level_rules", &scenario.level_rules)?;
+        let rules: LevelRules = load_reference(assets_root, scenario_path, "level_rules", &scenario.level_rules)?;
+        let costs = load_costs(assets_root, &assets_root.join(&scenario.level_rules), &rules)?;
         Self::assemble(
             scenario_path,
             assets_root,
             scenario,
             arena,
-            rules,
+            (rules, costs),
             |i, kind| {
                 let field = format!("creatures[{i}].kind");
                 let path = creature_file(assets_root, kind);
@@ -98,7 +103,7 @@ impl SimConfig {
         assets_root: &Path,
         scenario: Scenario,
         arena: ArenaConfig,
-        rules: LevelRules,
+        (rules, costs): (LevelRules, CostModel),
         mut kind_def: impl FnMut(usize, &str) -> Result<CreatureDef, ConfigError>,
         mut gait_table: impl FnMut(&Path, &str) -> Result<GaitTable, ConfigError>,
     ) -> Result<Self, ConfigError> {
@@ -127,6 +132,7 @@ impl SimConfig {
             kinds,
             gaits,
             rules,
+            costs,
         };
         config.check_fit(scenario_path)?;
         Ok(config)
@@ -249,6 +255,11 @@ fn gait_of(
         ));
     }
     Ok(Some(table))
+}
+
+/// The cost model the level rules (read from `rules_file`) name.
+pub fn load_costs(assets_root: &Path, rules_file: &Path, rules: &LevelRules) -> Result<CostModel, ConfigError> {
+    load_reference(assets_root, rules_file, "budget.cost_model", &rules.budget.cost_model)
 }
 
 /// The file a creature kind is defined in.

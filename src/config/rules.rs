@@ -21,6 +21,8 @@ pub struct LevelRules {
     /// How long what is drawn takes to blend from the old level's motion into the new one's
     /// after a switch (inertialization); 0 draws the switch as it happens. 0 to 2 s.
     pub blend_s: f32,
+    /// The `budget` policy: a frame budget spent where it changes the outcome most.
+    pub budget: BudgetRules,
 }
 
 /// Areas of influence (figure 5).
@@ -49,6 +51,41 @@ pub struct CameraRules {
     pub follow_distance_m: f32,
 }
 
+/// The `budget` policy (beyond the paper's conclusion: "cost/benefit heuristics might be
+/// designed to assign a switching priority for each creature").
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetRules {
+    /// Wall time of simulation allowed per 1/30 s of motion, predicted from the cost model;
+    /// 0 to 10,000 ms.
+    pub frame_budget_ms: f32,
+    /// The cost model's file, under the assets folder (`simlod bench --calibrate` writes it).
+    pub cost_model: String,
+    /// A contact this many seconds away is worth 1/e of one now; 0.01 to 60 s.
+    pub contact_horizon_s: f32,
+    /// Bodies count as touching this much before their footprints meet; 0 to 100 m.
+    pub contact_margin_m: f32,
+    /// The earliest contact possible (both turning toward each other at full speed) counts
+    /// this much of a contact on the present course; 0 to 1.
+    pub worst_case_share: f32,
+    /// Benefit of the rigid level for a contact now, by what it would be with: 0 to 1000 each.
+    pub puck_weight: f32,
+    pub wall_weight: f32,
+    pub creature_weight: f32,
+    /// In view, the benefit of seeing a creature halves at this distance from the camera;
+    /// 0.01 to 10,000 m.
+    pub view_half_distance_m: f32,
+    /// Benefit of the hybrid level (legs seen) for a creature in view at the camera; 0 to 1000.
+    pub view_hybrid_weight: f32,
+    /// Benefit of the rigid level for a creature in view at the camera; 0 to 1000.
+    pub view_rigid_weight: f32,
+    /// Benefit of the rigid level for the creature the camera follows (the player's); 0 to 1000.
+    pub player_rigid_weight: f32,
+    /// A creature's last chosen level counts this share more benefit, so one near the cut-off
+    /// does not flicker; 0 to 10.
+    pub hysteresis: f32,
+}
+
 impl Validate for LevelRules {
     fn validate(&self, v: &mut Validator) {
         v.nested("influence", |v| {
@@ -66,6 +103,26 @@ impl Validate for LevelRules {
         v.range("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
         v.range("min_dwell_s", self.min_dwell_s, 0.0, 3600.0);
         v.range("blend_s", self.blend_s, 0.0, 2.0);
+        v.nested("budget", |v| {
+            let b = &self.budget;
+            v.range("frame_budget_ms", b.frame_budget_ms, 0.0, 10_000.0);
+            v.asset_path("cost_model", &b.cost_model);
+            v.range("contact_horizon_s", b.contact_horizon_s, 0.01, 60.0);
+            v.range("contact_margin_m", b.contact_margin_m, 0.0, 100.0);
+            v.within("worst_case_share", b.worst_case_share, 0.0, 1.0);
+            for (field, w) in [
+                ("puck_weight", b.puck_weight),
+                ("wall_weight", b.wall_weight),
+                ("creature_weight", b.creature_weight),
+                ("view_hybrid_weight", b.view_hybrid_weight),
+                ("view_rigid_weight", b.view_rigid_weight),
+                ("player_rigid_weight", b.player_rigid_weight),
+            ] {
+                v.within(field, w, 0.0, 1000.0);
+            }
+            v.range("view_half_distance_m", b.view_half_distance_m, 0.01, 10_000.0);
+            v.within("hysteresis", b.hysteresis, 0.0, 10.0);
+        });
         let (a, b) = self.flight_window;
         v.range("flight_window.0", a, 0.0, 1.0);
         v.range("flight_window.1", b, 0.0, 1.0);

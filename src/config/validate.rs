@@ -164,7 +164,7 @@ pub fn number(x: f32) -> String {
 /// " m", " kg", ... for a field named with its unit, else nothing.
 fn unit_of(field: &str) -> &'static str {
     // Longest suffixes first: `_m_per_s2` before `_m_per_s` before `_s`.
-    const UNITS: [(&str, &str); 19] = [
+    const UNITS: [(&str, &str); 20] = [
         ("_cd_per_m2", " cd/m^2"),
         ("_nm_s_per_rad", " N m s/rad"),
         ("_nm_per_rad", " N m/rad"),
@@ -182,6 +182,7 @@ fn unit_of(field: &str) -> &'static str {
         ("_hz", " Hz"),
         ("_deg", " degrees"),
         ("_rad", " rad"),
+        ("_ms", " ms"),
         ("_m", " m"),
         ("_s", " s"),
     ];

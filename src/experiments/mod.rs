@@ -6,6 +6,7 @@
 //! process. Outcome trials (fig10) are independent and run on `--jobs` threads, each trial's
 //! simulation on one thread; they can be split into shards and merged.
 
+pub mod budget;
 pub mod fig10;
 pub mod fig7;
 pub mod frame_rate;
@@ -298,7 +299,7 @@ pub fn command(name: &str, options: &Options) -> String {
 }
 
 /// The experiments `simlod experiment all` runs, in the report's order.
-pub const ALL: [&str; 6] = report::ORDER;
+pub const ALL: [&str; 7] = report::ORDER;
 
 /// The experiment file `name` reads unless told otherwise: under the assets folder.
 pub fn default_file(assets: &Path, name: &str) -> PathBuf {
@@ -321,6 +322,7 @@ pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options)
         "fig7" => fig7::run(config, file, options),
         "fig8" | "fig9" => frame_rate::run(name, config, file, options),
         "fig10" => fig10::run(config, file, options),
+        "budget" => budget::run(config, file, options),
         _ => Err(format!("no experiment {name:?}; there are {}", ALL.join(", "))),
     }
 }

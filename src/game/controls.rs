@@ -13,7 +13,7 @@ use crate::lod::LevelPolicy;
 
 /// The keys, as the HUD lists them.
 pub const CONTROLS: &str = "WASD / arrows steer   Enter new round   C colour by level   \
-L level policy   [ ] puck radius   - = camera radius   P switch pops   Esc quit";
+L level policy   [ ] puck radius   - = camera radius   9 0 frame budget   P switch pops   Esc quit";
 
 /// Whether the HUD lists the last switches' pops (a debug display).
 #[derive(Resource, Debug, Default)]
@@ -114,6 +114,28 @@ fn read_game_keys(
                 "{} radius of influence {radius:.0} m{}",
                 which.name(),
                 if which.used_by(config.scenario.level_policy) {
+                    String::new()
+                } else {
+                    format!(
+                        " (the {} policy does not use it)",
+                        policy_name(config.scenario.level_policy)
+                    )
+                }
+            ));
+        }
+    }
+    // The budget policy's frame budget, live: it is spent anew at every decision.
+    for (key, by) in [
+        (KeyCode::Digit9, -settings.hud.budget_step_ms),
+        (KeyCode::Digit0, settings.hud.budget_step_ms),
+    ] {
+        if keys.just_pressed(key) {
+            let budget = (config.rules.budget.frame_budget_ms + by).max(0.0);
+            config.rules.budget.frame_budget_ms = budget;
+            base.rules.budget.frame_budget_ms = budget;
+            say(format!(
+                "frame budget {budget:.1} ms{}",
+                if config.scenario.level_policy == LevelPolicy::Budget {
                     String::new()
                 } else {
                     format!(
@@ -251,11 +273,11 @@ mod tests {
                 app.world().resource::<BaseConfig>().scenario.level_policy,
             )
         };
-        assert_eq!(policies(&app), (LevelPolicy::AllPointMass, LevelPolicy::AllPointMass));
+        assert_eq!(policies(&app), (LevelPolicy::Budget, LevelPolicy::Budget));
         assert_eq!(serials(&mut app), before, "the same creatures: no new round");
         press(&mut app, KeyCode::KeyL);
-        assert_eq!(policies(&app), (LevelPolicy::AllHybrid, LevelPolicy::AllHybrid));
-        assert!(app.world().resource::<Notice>().text.contains("all-hybrid"));
+        assert_eq!(policies(&app), (LevelPolicy::AllPointMass, LevelPolicy::AllPointMass));
+        assert!(app.world().resource::<Notice>().text.contains("all-point-mass"));
     }
 
     #[test]

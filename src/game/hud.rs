@@ -12,9 +12,10 @@ use super::controls::{CONTROLS, Notice, ShowPops, policy_name};
 use super::player::Round;
 use super::reload::Problems;
 use super::scene::{ColourByLevel, srgb};
+use crate::SimClock;
 use crate::config::SimConfig;
-use crate::lod::Lod;
 use crate::lod::PopTally;
+use crate::lod::{BudgetTally, LevelPolicy, Lod};
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -25,6 +26,10 @@ struct Timing {
     /// when `--screenshot` sets the game's time per frame.
     last_frame: Option<Instant>,
     sim_ms_per_frame: f32,
+    /// The same per 1/30 s of simulated motion (a decision's ticks), as the budget counts it.
+    sim_ms_per_decision: f32,
+    /// The tick the last frame's ticks ended at.
+    last_tick: u64,
     frames_per_s: f32,
 }
 
@@ -52,7 +57,7 @@ fn start_timing(mut timing: ResMut<Timing>) {
 
 /// Measured around the fixed loop, outside the simulation: the simulation never reads the
 /// clock.
-fn stop_timing(settings: Res<GameSettings>, mut timing: ResMut<Timing>) {
+fn stop_timing(settings: Res<GameSettings>, clock: Res<SimClock>, mut timing: ResMut<Timing>) {
     let Some(start) = timing.ticks_started.take() else {
         return;
     };
@@ -64,6 +69,13 @@ fn stop_timing(settings: Res<GameSettings>, mut timing: ResMut<Timing>) {
     let ease = 1.0 - (-dt / settings.hud.smoothing_s).exp();
     let sim_ms = start.elapsed().as_secs_f32() * 1000.0;
     timing.sim_ms_per_frame += (sim_ms - timing.sim_ms_per_frame) * ease;
+    let ticks = clock
+        .tick
+        .saturating_sub(std::mem::replace(&mut timing.last_tick, clock.tick));
+    if ticks > 0 {
+        let per_decision = sim_ms * clock.ticks_per_decision as f32 / ticks as f32;
+        timing.sim_ms_per_decision += (per_decision - timing.sim_ms_per_decision) * ease;
+    }
     if dt > 0.0 {
         timing.frames_per_s += (1.0 / dt - timing.frames_per_s) * ease;
     }
@@ -175,7 +187,13 @@ fn spawn_hud(mut commands: Commands, settings: Res<GameSettings>) {
         ));
 }
 
-fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConfig, pops: Option<&PopTally>) -> String {
+fn stats_text(
+    round: &Round,
+    timing: &Timing,
+    counts: &Summary,
+    (config, budget): (&SimConfig, &BudgetTally),
+    pops: Option<&PopTally>,
+) -> String {
     let mut s = String::new();
     let score = round.score.unwrap_or(super::player::Score {
         survived_s: 0.0,
@@ -208,6 +226,20 @@ fn stats_text(round: &Round, timing: &Timing, counts: &Summary, config: &SimConf
         rules.influence.puck_radius_m,
         rules.camera.radius_m
     );
+    if config.scenario.level_policy == LevelPolicy::Budget {
+        let _ = write!(
+            s,
+            "\nframe budget {:.1} ms per 1/30 s: predicted {:.2} ms, measured {:.2} ms{}",
+            rules.budget.frame_budget_ms,
+            budget.predicted_us / 1e3,
+            timing.sim_ms_per_decision,
+            if budget.over_budget > 0 {
+                format!("   over budget at {} decisions", budget.over_budget)
+            } else {
+                String::new()
+            }
+        );
+    }
     if let Some(pops) = pops {
         let _ = write!(s, "\nlast switches, pop as drawn (P hides):");
         for ((from, to, forced), pop) in pops.recent.iter().rev() {
@@ -231,7 +263,7 @@ fn show_hud(
     round: Res<Round>,
     timing: Res<Timing>,
     counts: Res<Counts>,
-    config: Res<SimConfig>,
+    (config, budget): (Res<SimConfig>, Res<BudgetTally>),
     problems: Res<Problems>,
     notice: Res<Notice>,
     show_pops: Res<ShowPops>,
@@ -242,7 +274,13 @@ fn show_hud(
         let (shown, wanted) = match which {
             HudText::Stats => (
                 true,
-                stats_text(&round, &timing, &counts.0, &config, show_pops.0.then_some(&*pops)),
+                stats_text(
+                    &round,
+                    &timing,
+                    &counts.0,
+                    (&config, &budget),
+                    show_pops.0.then_some(&*pops),
+                ),
             ),
             HudText::Level(level) => {
                 let n = counts.0.levels[*level];

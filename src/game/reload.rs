@@ -14,7 +14,7 @@ use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
 use crate::config::{
     ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file,
-    resolve_reference,
+    load_costs, resolve_reference,
 };
 use crate::gait::GaitTable;
 
@@ -189,12 +189,14 @@ fn assemble(
     if waiting {
         return Ok(None);
     }
+    // The cost model is read from disk whenever the config is put together (not watched).
+    let costs = load_costs(&root, &root.join(&scenario.level_rules), rules)?;
     SimConfig::assemble(
         &scenario_path,
         &root,
         scenario.clone(),
         arena.clone(),
-        rules.clone(),
+        (rules.clone(), costs),
         |_, kind| Ok(kinds.get(&watched.kinds[kind]).expect("loaded").clone()),
         |_, file| Ok(gaits.get(&watched.gaits[file]).expect("loaded").clone()),
     )

@@ -5,10 +5,12 @@
 //! hybrid (3.2) and the rigid body (3.1).
 
 mod blend;
+mod budget;
 mod select;
 mod switch;
 
 pub use blend::{Drawn, DrawnBefore, Pop, PopSummary, PopTally, Spread, SwitchBlend, SwitchProbe, drawn};
+pub use budget::{Allocation, BudgetSummary, BudgetTally, Candidate, allocate};
 pub use select::{CameraFromView, LevelChoice, SimCamera, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 
@@ -126,6 +128,9 @@ pub enum LevelPolicy {
     Camera,
     /// The more detailed of the two.
     Combined,
+    /// A frame budget: each creature's level chosen so that the predicted cost stays within
+    /// it, spent where a contact is soonest and the view nearest (beyond the paper).
+    Budget,
 }
 
 impl LevelPolicy {
@@ -133,16 +138,16 @@ impl LevelPolicy {
     pub fn is_dynamic(self) -> bool {
         matches!(
             self,
-            LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined
+            LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined | LevelPolicy::Budget
         )
     }
 
     /// The level a creature starts at, given the levels its kind has models for: the policy's
-    /// level (hybrid for the rules, which then move it), or the most detailed one below it
-    /// that the kind has.
+    /// level (hybrid for the rules, which then move it; the cheapest for the budget, which
+    /// then spends it), or the most detailed one below it that the kind has.
     pub fn initial_level(self, available: &[Lod]) -> Lod {
         let wanted = match self {
-            LevelPolicy::AllPointMass => Lod::PointMass,
+            LevelPolicy::AllPointMass | LevelPolicy::Budget => Lod::PointMass,
             LevelPolicy::AllHybrid | LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined => {
                 Lod::Hybrid
             }
@@ -159,6 +164,7 @@ impl LevelPolicy {
 
 pub(super) fn plugin(app: &mut App) {
     select::plugin(app);
+    budget::plugin(app);
     switch::plugin(app);
     blend::plugin(app);
 }

@@ -214,7 +214,7 @@ fn unsettle_levels(mut settled: ResMut<LevelsSettled>) {
 }
 
 /// At each decision, the level the policy wants for every creature, with hysteresis.
-fn select_levels(
+pub(super) fn select_levels(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
@@ -225,11 +225,12 @@ fn select_levels(
     mut settled: ResMut<LevelsSettled>,
     mut creatures: Query<(&Creature, &Lod, &PlanarState, &mut LevelChoice)>,
 ) {
-    if !clock.is_decision_tick() {
+    let policy = config.scenario.level_policy;
+    // The budget policy chooses for all creatures at once (`budget.rs`).
+    if !clock.is_decision_tick() || policy == LevelPolicy::Budget {
         return;
     }
     let rules = &config.rules;
-    let policy = config.scenario.level_policy;
     let inputs = LevelInputs::new(rules, &kinds, &puck, &court, &grid, &camera);
     let (enter, leave) = (
         Radii::of(rules, camera.half_view_rad, false),
@@ -269,7 +270,7 @@ fn select_levels(
 /// where they stand, in the rhythm and pose of that level, not at a default level they would
 /// leave in their first flight window. Every policy's levels are entered here, in one order,
 /// so that a puck area covering the court is the all-rigid game bit for bit.
-fn start_at_selected_levels(
+pub(super) fn start_at_selected_levels(
     mut commands: Commands,
     clock: Res<SimClock>,
     config: Res<SimConfig>,

@@ -10,9 +10,9 @@
 
 use bevy::prelude::*;
 
-use super::Lod;
 use super::blend::{Drawn, DrawnBefore, SwitchBlend, SwitchProbe};
 use super::select::{LevelChoice, levels_may_change};
+use super::{LevelPolicy, Lod};
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::outcome::{CollisionRecord, Counts, SwitchCounts};
@@ -60,15 +60,18 @@ fn switch_levels(
 ) {
     let now = clock.seconds() as f32;
     let (open, close) = config.rules.flight_window;
-    let rules_move_levels = config.scenario.level_policy.is_dynamic();
+    let policy = config.scenario.level_policy;
+    let rules_move_levels = policy.is_dynamic();
     for (entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before)) in &mut creatures {
         let kind = &kinds[creature.kind];
         // Under a fixed policy ("every creature at the point-mass level") a collision does not
-        // overrule it.
+        // overrule it; under the budget policy only a rigid level the budget paid for skips
+        // the window.
         let forced = rules_move_levels
             && lod != Lod::Rigid
             && record.touching.iter().any(|&t| t)
-            && kind.best_level(Lod::Rigid) == Lod::Rigid;
+            && kind.best_level(Lod::Rigid) == Lod::Rigid
+            && (policy != LevelPolicy::Budget || choice.wanted == Lod::Rigid);
         let target = if forced { Lod::Rigid } else { choice.wanted };
         if target == lod {
             if before.0.is_some() {

@@ -23,7 +23,9 @@ use crate::config::SimConfig;
 use crate::creature::{
     Creature, GaitPhase, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
 };
-use crate::lod::{AtRigid, LevelChoice, Lod, PopSummary, PopTally, SwitchTally};
+use crate::lod::{
+    AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, Lod, PopSummary, PopTally, SwitchTally,
+};
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart, WorldRng};
 
@@ -290,6 +292,9 @@ pub struct Summary {
     /// The pops of the switches in what is drawn, by kind of switch (from, to, forced by a
     /// collision or not): the largest and the 95th percentile.
     pub pops: Vec<PopSummary>,
+    /// Under the budget policy: the budget, the predicted frame and the decisions over it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub budget: Option<BudgetSummary>,
     pub sim_seconds: f64,
     /// Wall-clock seconds; the only field that differs between identical runs.
     pub wall_seconds: f64,
@@ -300,7 +305,10 @@ pub struct Summary {
 pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     let tally = world.resource::<Tally>().clone();
     let clock = *world.resource::<SimClock>();
-    let seed = world.resource::<SimConfig>().scenario.seed;
+    let config = world.resource::<SimConfig>();
+    let seed = config.scenario.seed;
+    let budget = (config.scenario.level_policy == LevelPolicy::Budget)
+        .then(|| world.resource::<BudgetTally>().summary(&config.rules.budget));
     let mut collisions = tally.removed_collisions;
     let mut collided = tally.removed_collided;
     let mut levels: Counts<Lod, u64> = Counts::default();
@@ -323,6 +331,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         levels_mean: Counts::from_fn(|l| switching.level_sums[l] as f64 / samples),
         levels_peak: switching.level_peaks,
         pops,
+        budget,
         seed,
         creatures,
         collisions,

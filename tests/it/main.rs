@@ -2,6 +2,7 @@
 //! steps.
 
 mod assets;
+mod budget;
 mod cli;
 mod court;
 mod determinism;

@@ -1,0 +1,82 @@
+//! The cost model of the budget policy: `assets/costs.ron`, written by `simlod bench
+//! --calibrate` from measured medians. What each level of each kind is predicted to cost, so
+//! that the budget is spent before the frame (Funkhouser & Sequin's predictive choice), not
+//! corrected after a slow one.
+
+use super::{Validate, Validator};
+use crate::lod::Lod;
+use serde::{Deserialize, Serialize};
+
+/// Predicted costs per kind and level.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CostModel {
+    /// One entry per calibrated kind.
+    pub kinds: Vec<KindCosts>,
+    /// What a kind without an entry is predicted to cost.
+    pub other_kinds: LevelCosts,
+}
+
+/// A kind's costs, by name.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KindCosts {
+    pub kind: String,
+    pub costs: LevelCosts,
+}
+
+/// Wall time of one creature's 1/30 s of simulated motion at each level (steering, collisions
+/// and its model), and of a switch into the rigid level (building its bodies), in
+/// microseconds; each 0 to 1,000,000 us.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LevelCosts {
+    pub point_mass_us_per_frame: f32,
+    pub hybrid_us_per_frame: f32,
+    pub rigid_us_per_frame: f32,
+    pub switch_to_rigid_us: f32,
+}
+
+impl LevelCosts {
+    /// Predicted microseconds per 1/30 s at `level`.
+    pub fn per_frame_us(&self, level: Lod) -> f32 {
+        match level {
+            Lod::PointMass => self.point_mass_us_per_frame,
+            Lod::Hybrid => self.hybrid_us_per_frame,
+            Lod::Rigid => self.rigid_us_per_frame,
+        }
+    }
+
+    fn validate(&self, v: &mut Validator) {
+        const MOST_US: f32 = 1_000_000.0;
+        v.within("point_mass_us_per_frame", self.point_mass_us_per_frame, 0.0, MOST_US);
+        v.within("hybrid_us_per_frame", self.hybrid_us_per_frame, 0.0, MOST_US);
+        v.within("rigid_us_per_frame", self.rigid_us_per_frame, 0.0, MOST_US);
+        v.within("switch_to_rigid_us", self.switch_to_rigid_us, 0.0, MOST_US);
+    }
+}
+
+impl CostModel {
+    /// The costs of the kind named `kind`.
+    pub fn of(&self, kind: &str) -> &LevelCosts {
+        self.kinds
+            .iter()
+            .find(|k| k.kind == kind)
+            .map_or(&self.other_kinds, |k| &k.costs)
+    }
+}
+
+impl Validate for CostModel {
+    fn validate(&self, v: &mut Validator) {
+        for (i, k) in self.kinds.iter().enumerate() {
+            v.nested(&format!("kinds[{i}]"), |v| {
+                v.kind_name("kind", &k.kind);
+                v.nested("costs", |v| k.costs.validate(v));
+            });
+            if self.kinds[..i].iter().any(|o| o.kind == k.kind) {
+                v.fail(&format!("kinds[{i}].kind"), format!("{:?} is listed twice", k.kind));
+            }
+        }
+        v.nested("other_kinds", |v| self.other_kinds.validate(v));
+    }
+}

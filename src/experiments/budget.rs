@@ -1,0 +1,408 @@
+//! The budget experiment (beyond the paper, issue 14): the budget policy against the paper's
+//! fixed radii on figure 10's axes, and the frame times of a crowded game.
+//!
+//! 1. The trade-off: trials of a game from their own seeds, each all rigid, under the influence
+//!    policy at each fixed puck radius (figure 10's rule), and under the budget policy at each
+//!    frame budget; for each, the mean change in creatures that collided with the puck or a
+//!    wall against all rigid, and the speed-up (all-rigid wall time over the policy's).
+//! 2. The crowd: one game of many creatures under all rigid, the influence policy and the
+//!    budget policy, every frame timed (can it hold 30 frames a second?).
+
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plot::{self, Mark, Panel, Series};
+use super::{ExperimentRecord, Options, command, load_settings, run_parallel, timed_game, trials};
+use crate::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
+use crate::headless;
+use crate::lod::{LevelPolicy, Lod};
+
+/// `assets/experiments/budget.ron`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetSettings {
+    /// The frame budgets the budget policy runs at, ms of simulation per 1/30 s.
+    pub budgets_ms: Vec<f32>,
+    /// The puck radii the fixed-radius curve runs at, under `fixed_rules`.
+    pub radii_m: Vec<f32>,
+    /// The level rules of the fixed-radius curve (figure 10's: the puck's area only).
+    pub fixed_rules: String,
+    /// The level rules of the budget policy (its weights; its cost model).
+    pub budget_rules: String,
+    /// Length of each trial.
+    pub seconds: f32,
+    pub trials: u32,
+    /// Trial `i` runs with seed `first_seed + i`.
+    pub first_seed: u64,
+    /// The crowded game: creatures (the scenario's mix, its court grown to the same density).
+    pub crowd_creatures: u32,
+    pub crowd_seconds: f32,
+    /// The frame budget of the crowded game's budget policy.
+    pub crowd_budget_ms: f32,
+}
+
+impl Validate for BudgetSettings {
+    fn validate(&self, v: &mut Validator) {
+        v.require(
+            !self.budgets_ms.is_empty(),
+            "budgets_ms",
+            "must list at least one budget",
+        );
+        for (i, b) in self.budgets_ms.iter().enumerate() {
+            v.range(&format!("budgets_ms[{i}]"), *b, 0.0, 10_000.0);
+        }
+        v.require(!self.radii_m.is_empty(), "radii_m", "must list at least one radius");
+        for (i, r) in self.radii_m.iter().enumerate() {
+            v.within(&format!("radii_m[{i}]"), *r, 0.0, 1e4);
+        }
+        v.asset_path("fixed_rules", &self.fixed_rules);
+        v.asset_path("budget_rules", &self.budget_rules);
+        v.within("seconds", self.seconds, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.require(self.trials >= 1, "trials", "must be at least 1");
+        v.require(
+            (1..=100_000).contains(&self.crowd_creatures),
+            "crowd_creatures",
+            format!("must be between 1 and 100000, got {}", self.crowd_creatures),
+        );
+        v.within("crowd_seconds", self.crowd_seconds, 1.0 / 30.0, 600.0);
+        v.range("crowd_budget_ms", self.crowd_budget_ms, 0.0, 10_000.0);
+    }
+}
+
+/// One policy's setting in the trade-off: a fixed radius or a frame budget.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Setting {
+    Radius(f32),
+    Budget(f32),
+}
+
+impl Setting {
+    fn policy(self) -> &'static str {
+        match self {
+            Setting::Radius(_) => "influence",
+            Setting::Budget(_) => "budget",
+        }
+    }
+
+    fn value(self) -> f32 {
+        match self {
+            Setting::Radius(r) | Setting::Budget(r) => r,
+        }
+    }
+}
+
+const HEADER: &str =
+    "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid";
+
+/// One trial under one setting, beside the identical trial all rigid.
+struct Row {
+    setting: Setting,
+    trial: u32,
+    seed: u64,
+    collided: u64,
+    collided_all_rigid: u64,
+    mean_rigid: f64,
+    wall_s: f64,
+    wall_s_all_rigid: f64,
+}
+
+impl Row {
+    fn difference(&self) -> f64 {
+        self.collided as f64 - self.collided_all_rigid as f64
+    }
+}
+
+/// The two rules files, read from the assets folder with the budget rules' cost model.
+struct Rules {
+    fixed: LevelRules,
+    budget: (LevelRules, crate::config::CostModel),
+}
+
+fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[Setting], trial: u32) -> Vec<Row> {
+    let seed = s.first_seed + u64::from(trial);
+    let seconds = f64::from(s.seconds);
+    let mut c = config.clone();
+    c.scenario.seed = seed;
+    c.rules = rules.fixed.clone();
+    c.scenario.level_policy = LevelPolicy::AllRigid;
+    let rigid = headless::run(c.clone(), seconds);
+    settings
+        .iter()
+        .map(|&setting| {
+            match setting {
+                Setting::Radius(r) => {
+                    c.rules = rules.fixed.clone();
+                    c.rules.influence.puck_radius_m = r;
+                    c.scenario.level_policy = LevelPolicy::Influence;
+                }
+                Setting::Budget(b) => {
+                    (c.rules, c.costs) = rules.budget.clone();
+                    c.rules.budget.frame_budget_ms = b;
+                    c.scenario.level_policy = LevelPolicy::Budget;
+                }
+            }
+            let run = headless::run(c.clone(), seconds);
+            Row {
+                setting,
+                trial,
+                seed,
+                collided: run.creatures_collided,
+                collided_all_rigid: rigid.creatures_collided,
+                mean_rigid: run.levels_mean[Lod::Rigid],
+                wall_s: run.wall_seconds,
+                wall_s_all_rigid: rigid.wall_seconds,
+            }
+        })
+        .collect()
+}
+
+/// Figures per setting.
+#[derive(Clone, Debug, Serialize)]
+struct Point {
+    policy: &'static str,
+    setting: f32,
+    trials: usize,
+    mean_difference: f64,
+    /// The mean of each trial's difference, without its sign: how far a trial's outcome moves.
+    mean_abs_difference: f64,
+    sd_difference: f64,
+    mean_rigid: f64,
+    speedup: f64,
+}
+
+fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
+    settings
+        .iter()
+        .map(|&setting| {
+            let at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
+            let n = at.len() as f64;
+            let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
+            let mean_difference = mean(&|r| r.difference());
+            let var = if at.len() > 1 {
+                at.iter()
+                    .map(|r| (r.difference() - mean_difference).powi(2))
+                    .sum::<f64>()
+                    / (n - 1.0)
+            } else {
+                0.0
+            };
+            Point {
+                policy: setting.policy(),
+                setting: setting.value(),
+                trials: at.len(),
+                mean_difference,
+                mean_abs_difference: mean(&|r| r.difference().abs()),
+                sd_difference: var.sqrt(),
+                mean_rigid: mean(&|r| r.mean_rigid),
+                speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
+            }
+        })
+        .collect()
+}
+
+/// The crowded game under one policy: each frame's wall time.
+#[derive(Clone, Debug, Serialize)]
+struct Crowd {
+    policy: &'static str,
+    frames: usize,
+    median_frame_ms: f64,
+    slowest_frame_ms: f64,
+    lowest_fps: f64,
+    mean_rigid: f64,
+    #[serde(skip)]
+    frame_ms: Vec<f64>,
+}
+
+fn crowd(config: &SimConfig, rules: &Rules, s: &BudgetSettings) -> Vec<Crowd> {
+    let mut base = crate::bench::scaled(config, s.crowd_creatures, LevelPolicy::AllRigid);
+    base.scenario.seed = s.first_seed;
+    [
+        ("all-rigid", LevelPolicy::AllRigid),
+        ("influence", LevelPolicy::Influence),
+        ("budget", LevelPolicy::Budget),
+    ]
+    .into_iter()
+    .map(|(name, policy)| {
+        let mut c = base.clone();
+        (c.rules, c.costs) = rules.budget.clone();
+        c.rules.budget.frame_budget_ms = s.crowd_budget_ms;
+        c.scenario.level_policy = policy;
+        let (frames, summary) = timed_game(c, f64::from(s.crowd_seconds));
+        let frame_ms: Vec<f64> = frames.iter().map(|f| f * 1e3).collect();
+        let slowest = frame_ms.iter().copied().fold(0.0, f64::max);
+        eprintln!("budget: the crowd of {} under {name}: done", s.crowd_creatures);
+        Crowd {
+            policy: name,
+            frames: frame_ms.len(),
+            median_frame_ms: super::median_of(frame_ms.iter().copied()),
+            slowest_frame_ms: slowest,
+            lowest_fps: 1e3 / slowest,
+            mean_rigid: summary.levels_mean[Lod::Rigid],
+            frame_ms,
+        }
+    })
+    .collect()
+}
+
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+    let s: BudgetSettings = load_settings(file, options)?;
+    let s = BudgetSettings {
+        trials: trials(options, s.trials),
+        ..s
+    };
+    let read = |field: &str, name: &str| -> Result<LevelRules, String> {
+        load_file(&options.assets.join(name)).map_err(|e| format!("{e} (named by {}: field `{field}`)", file.display()))
+    };
+    let budget_rules = read("budget_rules", &s.budget_rules)?;
+    let costs =
+        load_costs(&options.assets, &options.assets.join(&s.budget_rules), &budget_rules).map_err(|e| e.to_string())?;
+    let rules = Rules {
+        fixed: read("fixed_rules", &s.fixed_rules)?,
+        budget: (budget_rules, costs),
+    };
+    let settings: Vec<Setting> = s
+        .radii_m
+        .iter()
+        .map(|&r| Setting::Radius(r))
+        .chain(s.budgets_ms.iter().map(|&b| Setting::Budget(b)))
+        .collect();
+    let todo: Vec<u32> = (0..s.trials).collect();
+    let mut rows = Vec::new();
+    let mut progress = super::Progress::new("budget trials", todo.len() as u64);
+    run_parallel(
+        &todo,
+        options.jobs,
+        |&t| run_trial(config, &rules, &s, &settings, t),
+        |_, r| {
+            rows.extend(r);
+            progress.inc();
+        },
+    );
+    drop(progress);
+    rows.sort_by_key(|r| r.trial);
+    let points = summarise(&rows, &settings);
+    let crowd = crowd(config, &rules, &s);
+    finish(&rows, &points, &crowd, &s, options)
+}
+
+fn finish(
+    rows: &[Row],
+    points: &[Point],
+    crowd: &[Crowd],
+    s: &BudgetSettings,
+    options: &Options,
+) -> Result<String, String> {
+    let out = &options.out;
+    let mut csv = format!("{HEADER}\n");
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4}",
+            r.setting.policy(),
+            r.setting.value(),
+            r.trial,
+            r.seed,
+            s.seconds,
+            r.collided,
+            r.collided_all_rigid,
+            r.difference(),
+            r.mean_rigid,
+            r.wall_s,
+            r.wall_s_all_rigid
+        );
+    }
+    let curve = |policy: &str| -> Vec<&Point> { points.iter().filter(|p| p.policy == policy).collect() };
+    let (fixed, budget) = (curve("influence"), curve("budget"));
+    let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, p.speedup)).collect::<Vec<_>>();
+    let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
+        ps.iter()
+            .map(|p| (p.mean_difference, p.speedup, format!("  {}{unit}", p.setting)))
+            .collect()
+    };
+    let mut trace_series = Vec::new();
+    for (i, c) in crowd.iter().enumerate() {
+        let points = c
+            .frame_ms
+            .iter()
+            .enumerate()
+            .map(|(f, &ms)| (f as f64 / 30.0, ms))
+            .collect();
+        trace_series.push(Series::new(
+            format!("{} (slowest {:.0} ms)", c.policy, c.slowest_frame_ms),
+            points,
+            Mark::Line,
+            i,
+        ));
+    }
+    let frames = crowd.first().map_or(0, |c| c.frames);
+    trace_series.push(Series::new(
+        "1/30 s: 30 fps",
+        vec![(0.0, 1e3 / 30.0), (frames as f64 / 30.0, 1e3 / 30.0)],
+        Mark::Dashed,
+        5,
+    ));
+    plot::draw(
+        &out.join("budget.png"),
+        1400,
+        600,
+        &[
+            Panel {
+                title: format!("speed against outcome ({} trials of {} s each)", s.trials, s.seconds),
+                x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
+                y_label: "speed-up over all rigid (wall time)".into(),
+                series: vec![
+                    Series::new("fixed puck radius (figure 10's rule)", trade(&fixed), Mark::Line, 0),
+                    Series::new("budget policy", trade(&budget), Mark::Line, 1),
+                ],
+                notes: notes(&fixed, " m").into_iter().chain(notes(&budget, " ms")).collect(),
+                ..Panel::default()
+            },
+            Panel {
+                title: format!("frame times of a game of {} creatures", s.crowd_creatures),
+                x_label: "simulated time (s)".into(),
+                y_label: "wall time of the frame's simulation (ms)".into(),
+                log_y: true,
+                series: trace_series,
+                ..Panel::default()
+            },
+        ],
+    )?;
+    let mut report = format!(
+        "The budget policy (issue 14) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
+         trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
+         The difference is the policy's creatures that collided with the puck or a wall minus all rigid's; \
+         the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`).\n\n\
+         | policy | setting | difference: mean | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up |\n|---|---|---|---|---|---|---|\n",
+        s.trials, s.seconds, s.first_seed, s.fixed_rules, s.budget_rules
+    );
+    for p in points {
+        let unit = if p.policy == "budget" { "ms" } else { "m" };
+        let _ = writeln!(
+            report,
+            "| {} | {} {unit} | {:+.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
+            p.policy, p.setting, p.mean_difference, p.mean_abs_difference, p.sd_difference, p.mean_rigid, p.speedup
+        );
+    }
+    let _ = write!(
+        report,
+        "\nThe crowd: one game of {} creatures (the scenario's mix, the court grown to its density), {} s, seed {}, the budget policy at {} ms; \
+         every frame's simulation timed, one process, one policy after the other.\n\n\
+         | policy | frames | median frame (ms) | slowest frame (ms) | lowest fps | rigid creatures (mean) |\n|---|---|---|---|---|---|\n",
+        s.crowd_creatures, s.crowd_seconds, s.first_seed, s.crowd_budget_ms
+    );
+    for c in crowd {
+        let _ = writeln!(
+            report,
+            "| {} | {} | {:.2} | {:.2} | {:.1} | {:.1} |",
+            c.policy, c.frames, c.median_frame_ms, c.slowest_frame_ms, c.lowest_fps, c.mean_rigid
+        );
+    }
+    ExperimentRecord {
+        experiment: "budget".into(),
+        command: command("budget", options),
+        summary: serde_json::json!({ "points": points, "crowd": crowd }),
+        report,
+    }
+    .finish(out, &csv)
+}

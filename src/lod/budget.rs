@@ -1,0 +1,536 @@
+//! The `budget` policy: a frame budget spent where it changes the outcome most (beyond the
+//! paper, after its conclusion: "cost/benefit heuristics might be designed to assign a
+//! switching priority for each creature. Thus a consistent frame rate could be maintained by
+//! using lower levels of detail for the lowest priority creatures").
+//!
+//! At each decision every creature gets a benefit for each level its kind has, from the
+//! paper's two criteria made continuous: how soon a contact with the puck, a wall or another
+//! creature could come (a time to contact from positions and velocities, where 3.4 has areas
+//! of influence), and how much the viewer sees of it (in view, how near the camera, the
+//! followed creature first; 3.4's camera rule). Each level has a predicted cost from the cost
+//! model (`assets/costs.ron`), and going rigid costs the building of its bodies once more.
+//! The levels are chosen as a multiple-choice knapsack, greedily by benefit per cost
+//! (Funkhouser & Sequin, SIGGRAPH '93), so that the predicted cost of the frame stays within
+//! the budget. It starts from the last decision: a creature in its dwell keeps at least its
+//! level, its last chosen level counts `hysteresis` more, and the switch itself still waits
+//! for the flight window (`switch.rs`). No clock is read: the same files give the same run.
+
+use bevy::ecs::system::SystemParam;
+use bevy::prelude::*;
+use serde::Serialize;
+
+use super::select::{LevelChoice, SimCamera, select_levels, start_at_selected_levels};
+use super::{LevelPolicy, Lod};
+use crate::arena::{Court, PuckState};
+use crate::config::{BudgetRules, LevelCosts, SimConfig};
+use crate::creature::{Creature, GaitPhase, KindTable, PlanarState, starting_gait};
+use crate::gait::GaitPose;
+use crate::sense::NeighbourGrid;
+use crate::{SimClock, SimStage, SimStart};
+
+/// One creature as the knapsack sees it.
+#[derive(Clone, Debug)]
+pub struct Candidate<'a> {
+    pub serial: u32,
+    /// The level it is simulated at now.
+    pub current: Lod,
+    /// The level the last decision chose (it gets the hysteresis).
+    pub last: Lod,
+    /// The lowest level it may be given (its current one while it dwells).
+    pub floor: Lod,
+    /// The levels its kind has, cheapest first.
+    pub levels: &'a [Lod],
+    pub costs: LevelCosts,
+    /// Benefit of each level, indexed by `Lod as usize`.
+    pub benefit: [f32; 3],
+}
+
+impl Candidate<'_> {
+    /// Predicted microseconds of the frame if the creature is given `level`: the level's cost,
+    /// and the building of its bodies if it goes rigid now.
+    fn cost_us(&self, level: Lod) -> f32 {
+        let switch = if level == Lod::Rigid && self.current != Lod::Rigid {
+            self.costs.switch_to_rigid_us
+        } else {
+            0.0
+        };
+        self.costs.per_frame_us(level) + switch
+    }
+
+    /// Predicted microseconds of the frame while the creature moves toward `level`: until its
+    /// flight window it still runs at its current level, if that is the dearer.
+    fn frame_cost_us(&self, level: Lod) -> f32 {
+        self.cost_us(level.max(self.current))
+    }
+
+    fn value(&self, level: Lod, hysteresis: f32) -> f32 {
+        let b = self.benefit[level as usize];
+        if level == self.last { b * (1.0 + hysteresis) } else { b }
+    }
+}
+
+/// The levels chosen, and what the frame is predicted to cost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Allocation {
+    /// One per candidate, in the candidates' order.
+    pub levels: Vec<Lod>,
+    pub predicted_us: f32,
+    /// Even the cheapest allowed levels cost more than the budget.
+    pub exceeded: bool,
+}
+
+/// One step up a creature's levels on the knapsack's upper hull.
+struct Step {
+    ratio: f32,
+    creature: usize,
+    from: Lod,
+    to: Lod,
+    extra_us: f32,
+}
+
+/// Chooses a level for each candidate: from each one's floor, the steps up with the most
+/// benefit per microsecond first, while the budget allows (a multiple-choice knapsack solved
+/// greedily on each creature's upper convex hull of cost and benefit). Then, since a creature
+/// going down keeps costing its old level until its flight window, the last steps taken are
+/// given back until the frame as it will run fits. Deterministic: ties go to the lower serial.
+pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32) -> Allocation {
+    let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
+    let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
+    let mut steps = Vec::new();
+    for (i, c) in candidates.iter().enumerate() {
+        let mut at = c.floor;
+        loop {
+            let (cost, value) = (c.cost_us(at), c.value(at, hysteresis));
+            let best = c
+                .levels
+                .iter()
+                .copied()
+                .filter(|&l| l > at && c.value(l, hysteresis) > value)
+                .map(|l| {
+                    let extra = c.cost_us(l) - cost;
+                    let gain = c.value(l, hysteresis) - value;
+                    (if extra > 0.0 { gain / extra } else { f32::INFINITY }, l, extra)
+                })
+                .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
+            let Some((ratio, to, extra_us)) = best else { break };
+            steps.push(Step {
+                ratio,
+                creature: i,
+                from: at,
+                to,
+                extra_us,
+            });
+            at = to;
+        }
+    }
+    steps.sort_by(|a, b| {
+        b.ratio
+            .total_cmp(&a.ratio)
+            .then(candidates[a.creature].serial.cmp(&candidates[b.creature].serial))
+            .then(a.to.cmp(&b.to))
+    });
+    let mut taken = Vec::new();
+    for step in &steps {
+        if levels[step.creature] == step.from && spent + step.extra_us <= budget_us {
+            levels[step.creature] = step.to;
+            spent += step.extra_us;
+            taken.push(step);
+        }
+    }
+    let frame = |levels: &[Lod]| -> f32 { candidates.iter().zip(levels).map(|(c, &l)| c.frame_cost_us(l)).sum() };
+    let mut predicted_us = frame(&levels);
+    for step in taken.iter().rev() {
+        if predicted_us <= budget_us {
+            break;
+        }
+        levels[step.creature] = step.from;
+        predicted_us = frame(&levels);
+    }
+    Allocation {
+        levels,
+        predicted_us,
+        exceeded: predicted_us > budget_us,
+    }
+}
+
+/// What the budget policy predicted, decision by decision (the summary and the HUD read it).
+#[derive(Resource, Clone, Debug, Default)]
+pub struct BudgetTally {
+    /// The last decision's predicted simulation time of a frame.
+    pub predicted_us: f32,
+    pub decisions: u64,
+    /// Decisions whose predicted frame did not fit the budget even at the cheapest levels
+    /// allowed.
+    pub over_budget: u64,
+    pub predicted_sum_us: f64,
+    pub predicted_max_us: f32,
+}
+
+/// The budget policy's run, in the summary.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BudgetSummary {
+    pub frame_budget_ms: f32,
+    pub predicted_ms_mean: f64,
+    pub predicted_ms_max: f32,
+    pub decisions: u64,
+    /// Decisions where even the cheapest levels allowed were predicted over the budget.
+    pub decisions_over_budget: u64,
+}
+
+impl BudgetTally {
+    pub fn summary(&self, rules: &BudgetRules) -> BudgetSummary {
+        BudgetSummary {
+            frame_budget_ms: rules.frame_budget_ms,
+            predicted_ms_mean: self.predicted_sum_us / self.decisions.max(1) as f64 / 1e3,
+            predicted_ms_max: self.predicted_max_us / 1e3,
+            decisions: self.decisions,
+            decisions_over_budget: self.over_budget,
+        }
+    }
+
+    fn record(&mut self, a: &Allocation) {
+        self.predicted_us = a.predicted_us;
+        self.decisions += 1;
+        self.over_budget += u64::from(a.exceeded);
+        self.predicted_sum_us += f64::from(a.predicted_us);
+        self.predicted_max_us = self.predicted_max_us.max(a.predicted_us);
+    }
+}
+
+/// Seconds until two discs, `d` apart (one's centre minus the other's) with relative velocity
+/// `w`, come within `reach` of each other on their present courses: 0 if they are, infinite if
+/// they never do.
+pub fn time_to_contact(d: Vec2, w: Vec2, reach: f32) -> f32 {
+    let c = d.length_squared() - reach * reach;
+    if c <= 0.0 {
+        return 0.0;
+    }
+    let (a, b) = (w.length_squared(), 2.0 * d.dot(w));
+    let disc = b * b - 4.0 * a * c;
+    if a <= 1e-12 || b >= 0.0 || disc < 0.0 {
+        return f32::INFINITY;
+    }
+    (-b - disc.sqrt()) / (2.0 * a)
+}
+
+/// What the benefits are computed from at one decision.
+struct Scene<'a> {
+    rules: &'a BudgetRules,
+    puck: &'a PuckState,
+    court: &'a Court,
+    grid: &'a NeighbourGrid,
+    camera: &'a SimCamera,
+    /// The fastest kind's top speed, for the earliest possible contacts.
+    top_speed: f32,
+    /// How far away another creature can still matter.
+    reach_m: f32,
+    view_cos: f32,
+}
+
+impl Scene<'_> {
+    /// How much a contact on the present course `t_course` seconds away, and at the
+    /// earliest `t_worst` away, is worth.
+    fn urgency(&self, t_course: f32, t_worst: f32) -> f32 {
+        let h = self.rules.contact_horizon_s;
+        (-t_course / h)
+            .exp()
+            .max(self.rules.worst_case_share * (-t_worst / h).exp())
+    }
+
+    /// Benefit of the rigid level from how soon a contact could come.
+    fn contact(&self, c: &Creature, s: &PlanarState, radius: f32) -> f32 {
+        let (r, margin) = (self.rules, self.rules.contact_margin_m);
+        let mut best = 0.0f32;
+        // The puck.
+        let d = s.position - self.puck.position;
+        let reach = radius + self.puck.radius_m + margin;
+        let gap = (d.length() - reach).max(0.0);
+        let closing = self.top_speed + self.puck.velocity.length();
+        let t = time_to_contact(d, s.velocity - self.puck.velocity, reach);
+        best = best.max(r.puck_weight * self.urgency(t, gap / closing.max(1e-3)));
+        // The walls: the nearest on each axis.
+        let room = self.court.half_extents - Vec2::splat(radius + margin) - s.position.abs();
+        let along = s.velocity * s.position.signum();
+        let course = |room: f32, v: f32| {
+            if room <= 0.0 {
+                0.0
+            } else if v > 0.0 {
+                room / v
+            } else {
+                f32::INFINITY
+            }
+        };
+        let t = course(room.x, along.x).min(course(room.y, along.y));
+        let gap = room.min_element().max(0.0);
+        best = best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)));
+        // Other creatures.
+        if r.creature_weight > 0.0 {
+            self.grid.for_each_within(s.position, self.reach_m, |n| {
+                if n.serial == c.serial {
+                    return;
+                }
+                let d = s.position - n.position;
+                let reach = radius + n.radius + margin;
+                let gap = (d.length() - reach).max(0.0);
+                let t = time_to_contact(d, s.velocity - n.velocity, reach);
+                best = best.max(r.creature_weight * self.urgency(t, gap / (2.0 * self.top_speed).max(1e-3)));
+            });
+        }
+        best
+    }
+
+    /// How much the viewer sees of a creature: 0 out of view, 1 at the camera, halving at
+    /// `view_half_distance_m`.
+    fn view(&self, s: &PlanarState) -> f32 {
+        let to = s.position - self.camera.position;
+        let distance = to.length();
+        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.view_cos;
+        if in_view {
+            1.0 / (1.0 + distance / self.rules.view_half_distance_m)
+        } else {
+            0.0
+        }
+    }
+
+    /// Benefit of each level for one creature.
+    fn benefit(&self, entity: Entity, c: &Creature, s: &PlanarState, radius: f32) -> [f32; 3] {
+        let r = self.rules;
+        let view = self.view(s);
+        let hybrid = r.view_hybrid_weight * view;
+        let followed = if self.camera.following == Some(entity) {
+            r.player_rigid_weight
+        } else {
+            0.0
+        };
+        let rigid = hybrid + r.view_rigid_weight * view + followed + self.contact(c, s, radius);
+        [0.0, hybrid, rigid]
+    }
+}
+
+type Creatures<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        &'static Creature,
+        &'static Lod,
+        &'static PlanarState,
+        &'static mut LevelChoice,
+    ),
+>;
+
+/// The allocation for every creature now, in the order of their serials.
+fn decide(
+    now_s: f32,
+    config: &SimConfig,
+    kinds: &KindTable,
+    scene: &Scene,
+    creatures: &Creatures,
+) -> (Vec<Entity>, Allocation) {
+    let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
+    let mut rows: Vec<_> = creatures.iter().collect();
+    rows.sort_unstable_by_key(|r| r.1.serial);
+    let candidates: Vec<Candidate> = rows
+        .iter()
+        .map(|&(entity, c, &lod, s, choice)| {
+            let kind = &kinds[c.kind];
+            let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
+            Candidate {
+                serial: c.serial,
+                current: lod,
+                last: choice.wanted,
+                floor: if dwelling { lod } else { kind.levels[0] },
+                levels: &kind.levels,
+                costs: costs[c.kind],
+                benefit: scene.benefit(entity, c, s, kind.radius_m),
+            }
+        })
+        .collect();
+    let budget = config.rules.budget.frame_budget_ms * 1e3;
+    let allocation = allocate(&candidates, budget, config.rules.budget.hysteresis);
+    (rows.iter().map(|r| r.0).collect(), allocation)
+}
+
+fn scene<'a>(
+    config: &'a SimConfig,
+    kinds: &KindTable,
+    puck: &'a PuckState,
+    court: &'a Court,
+    grid: &'a NeighbourGrid,
+    camera: &'a SimCamera,
+) -> Scene<'a> {
+    let rules = &config.rules.budget;
+    let top_speed = kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
+    let biggest = kinds.0.iter().map(|k| k.radius_m).fold(0.0, f32::max);
+    Scene {
+        rules,
+        puck,
+        court,
+        grid,
+        camera,
+        top_speed,
+        // Beyond three horizons at both creatures' top speeds, a contact is worth under 5 %.
+        reach_m: 2.0 * biggest + rules.contact_margin_m + 2.0 * top_speed * 3.0 * rules.contact_horizon_s,
+        view_cos: camera.half_view_rad.min(std::f32::consts::PI).cos(),
+    }
+}
+
+/// What a decision reads besides the creatures.
+#[derive(SystemParam)]
+struct Inputs<'w> {
+    clock: Res<'w, SimClock>,
+    config: Res<'w, SimConfig>,
+    kinds: Res<'w, KindTable>,
+    puck: Res<'w, PuckState>,
+    court: Res<'w, Court>,
+    grid: Res<'w, NeighbourGrid>,
+    camera: Res<'w, SimCamera>,
+}
+
+impl Inputs<'_> {
+    /// The allocation for every creature now, in the order of their serials.
+    fn decide(&self, creatures: &Creatures) -> (Vec<Entity>, Allocation) {
+        let scene = scene(
+            &self.config,
+            &self.kinds,
+            &self.puck,
+            &self.court,
+            &self.grid,
+            &self.camera,
+        );
+        decide(
+            self.clock.seconds() as f32,
+            &self.config,
+            &self.kinds,
+            &scene,
+            creatures,
+        )
+    }
+}
+
+/// At each decision, under the budget policy: every creature's wanted level.
+fn choose_by_budget(inputs: Inputs, mut tally: ResMut<BudgetTally>, mut creatures: Creatures) {
+    if !inputs.clock.is_decision_tick() {
+        return;
+    }
+    let (entities, allocation) = inputs.decide(&creatures);
+    tally.record(&allocation);
+    for (entity, &level) in entities.iter().zip(&allocation.levels) {
+        if let Ok((.., mut choice)) = creatures.get_mut(*entity)
+            && choice.wanted != level
+        {
+            choice.wanted = level;
+        }
+    }
+}
+
+/// A new world under the budget policy: its creatures, placed at the cheapest level, start at
+/// the levels the budget gives them (in that level's rhythm and pose).
+fn start_by_budget(
+    mut commands: Commands,
+    inputs: Inputs,
+    mut tally: ResMut<BudgetTally>,
+    mut creatures: Creatures,
+    mut gaits: Query<(&mut GaitPhase, &mut GaitPose)>,
+) {
+    *tally = BudgetTally::default();
+    if inputs.config.scenario.level_policy != LevelPolicy::Budget {
+        return;
+    }
+    let now = inputs.clock.seconds() as f32;
+    let (entities, allocation) = inputs.decide(&creatures);
+    for (&entity, &level) in entities.iter().zip(&allocation.levels) {
+        let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
+            continue;
+        };
+        if level != lod
+            && let Ok((mut gait, mut pose)) = gaits.get_mut(entity)
+        {
+            (*gait, *pose) = starting_gait(level, &inputs.kinds[c.kind], gait.cycle, now);
+            commands.entity(entity).insert(level);
+        }
+        choice.wanted = level;
+    }
+}
+
+pub(super) fn plugin(app: &mut App) {
+    app.init_resource::<BudgetTally>()
+        .add_systems(SimStart, start_by_budget.after(start_at_selected_levels))
+        .add_systems(
+            FixedUpdate,
+            choose_by_budget
+                .in_set(SimStage::SelectLod)
+                .after(select_levels)
+                .run_if(|config: Res<SimConfig>| config.scenario.level_policy == LevelPolicy::Budget),
+        );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const COSTS: LevelCosts = LevelCosts {
+        point_mass_us_per_frame: 1.0,
+        hybrid_us_per_frame: 2.0,
+        rigid_us_per_frame: 100.0,
+        switch_to_rigid_us: 50.0,
+    };
+
+    fn candidate(serial: u32, current: Lod, rigid_benefit: f32) -> Candidate<'static> {
+        Candidate {
+            serial,
+            current,
+            last: current,
+            floor: Lod::PointMass,
+            levels: &Lod::ALL,
+            costs: COSTS,
+            benefit: [0.0, 0.5, rigid_benefit],
+        }
+    }
+
+    #[test]
+    fn a_contact_ahead_comes_at_the_closing_time_and_a_passing_body_never() {
+        // 10 m apart, closing at 2 m/s, touching at 1 m: 4.5 s.
+        let t = time_to_contact(Vec2::new(10.0, 0.0), Vec2::new(-2.0, 0.0), 1.0);
+        assert!((t - 4.5).abs() < 1e-5, "{t}");
+        assert_eq!(
+            time_to_contact(Vec2::new(10.0, 0.0), Vec2::new(2.0, 0.0), 1.0),
+            f32::INFINITY
+        );
+        assert_eq!(
+            time_to_contact(Vec2::new(10.0, 5.0), Vec2::new(-2.0, 0.0), 1.0),
+            f32::INFINITY
+        );
+        assert_eq!(time_to_contact(Vec2::new(0.5, 0.0), Vec2::ZERO, 1.0), 0.0);
+    }
+
+    #[test]
+    fn the_budget_goes_to_the_most_benefit_per_cost_and_is_never_exceeded() {
+        let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
+        // Room for two going rigid and three hybrids (2 x (100 + 50) + 3 x 2 = 306).
+        let a = allocate(&cs, 310.0, 0.0);
+        assert_eq!(
+            a.levels,
+            [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]
+        );
+        assert!(a.predicted_us <= 310.0 && !a.exceeded, "{a:?}");
+    }
+
+    #[test]
+    fn a_creature_going_down_still_counts_until_it_switches() {
+        // One rigid now, with no benefit left; one hybrid with a contact ahead. Going down in
+        // the flight window, the first still costs its rigid level this frame: no room yet.
+        let cs = [candidate(0, Lod::Rigid, 0.0), candidate(1, Lod::Hybrid, 5.0)];
+        let a = allocate(&cs, 160.0, 0.0);
+        assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid]);
+        assert!(a.predicted_us <= 160.0, "{a:?}");
+    }
+
+    #[test]
+    fn too_small_a_budget_gives_the_cheapest_levels_and_says_so() {
+        let cs: Vec<_> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
+        let a = allocate(&cs, 1.0, 0.0);
+        assert_eq!(a.levels, [Lod::PointMass; 3]);
+        assert!(a.exceeded);
+    }
+}

@@ -1,0 +1,171 @@
+//! The budget policy: the predicted frame stays within the budget, the budget goes where a
+//! contact comes soonest, the same files give the same run, and a budget too small for even
+//! the cheapest levels is said, not refused.
+
+use bevy::prelude::*;
+
+use crate::support::*;
+use simlod::arena::PuckState;
+use simlod::config::{CostModel, LevelCosts, SimConfig};
+use simlod::creature::{Creature, PlanarState};
+use simlod::headless::HeadlessSim;
+use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
+
+/// Costs set here, so that the tests do not move with the machine's calibration.
+const COSTS: LevelCosts = LevelCosts {
+    point_mass_us_per_frame: 1.0,
+    hybrid_us_per_frame: 2.0,
+    rigid_us_per_frame: 100.0,
+    switch_to_rigid_us: 50.0,
+};
+
+/// `hoppers` hoppers under the budget policy with `budget_ms` and the costs above.
+fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
+    let mut config = scene(&[("hopper", hoppers)], LevelPolicy::Budget);
+    config.costs = CostModel {
+        kinds: vec![],
+        other_kinds: COSTS,
+    };
+    config.rules.budget.frame_budget_ms = budget_ms;
+    config
+}
+
+/// What the creatures' levels cost now, by the cost model.
+fn cost_of_levels_us(sim: &mut HeadlessSim) -> f32 {
+    let world = sim.app.world_mut();
+    world
+        .query_filtered::<&Lod, With<Creature>>()
+        .iter(world)
+        .map(|&l| COSTS.per_frame_us(l))
+        .sum()
+}
+
+#[test]
+fn the_predicted_cost_never_exceeds_the_budget() {
+    // 30 hoppers and room for four or five rigid ones.
+    let budget_ms = 0.6;
+    let mut sim = HeadlessSim::new(budget_scene(30, budget_ms));
+    let mut rigid_seen = 0;
+    for _ in 0..(15 * 30) {
+        sim.advance_frame();
+        let tally = sim.app.world().resource::<BudgetTally>().clone();
+        assert!(
+            tally.predicted_us <= budget_ms * 1e3,
+            "predicted {} us at {} s",
+            tally.predicted_us,
+            sim.clock().seconds()
+        );
+        assert_eq!(tally.over_budget, 0);
+        let levels_us = cost_of_levels_us(&mut sim);
+        assert!(levels_us <= budget_ms * 1e3, "the levels cost {levels_us} us");
+        let world = sim.app.world_mut();
+        rigid_seen = rigid_seen.max(world.query::<&Lod>().iter(world).filter(|&&l| l == Lod::Rigid).count());
+    }
+    // The budget is spent, not hoarded: some creatures were rigid.
+    assert!(rigid_seen >= 3, "at most {rigid_seen} rigid");
+    let summary = sim.summary(0.0).budget.expect("a budget summary");
+    assert_eq!(summary.decisions_over_budget, 0);
+    assert!(summary.predicted_ms_max <= budget_ms);
+}
+
+#[test]
+fn the_creature_about_to_be_hit_is_rigid_before_the_one_far_from_everything() {
+    // Two hoppers, and only the contact counts (no view, no followed creature). With no
+    // budget both start at the point mass; then one is put just ahead of the puck, the other
+    // far from the puck and the walls, and the budget made room for one rigid creature.
+    let mut config = budget_scene(2, 0.0);
+    let b = &mut config.rules.budget;
+    (b.view_hybrid_weight, b.view_rigid_weight, b.player_rigid_weight) = (0.0, 0.0, 0.0);
+    let mut sim = HeadlessSim::new(config);
+    sim.advance_frame();
+    let world = sim.app.world_mut();
+    let puck = *world.resource::<PuckState>();
+    let half = world.resource::<simlod::arena::Court>().half_extents;
+    let ahead = puck.position + puck.velocity.normalize() * (puck.radius_m + 2.5);
+    let far = [Vec2::new(-12.0, 0.0), Vec2::new(12.0, 0.0), Vec2::ZERO]
+        .into_iter()
+        .max_by(|a, b| a.distance(puck.position).total_cmp(&b.distance(puck.position)))
+        .unwrap();
+    assert!(far.distance(puck.position) > 12.0 && (half - far.abs()).min_element() > 8.0);
+    assert!(
+        (half - ahead.abs()).min_element() > 1.0,
+        "the puck is too near a wall: {puck:?}"
+    );
+    let mut serials = Vec::new();
+    for (c, mut s) in world.query::<(&Creature, &mut PlanarState)>().iter_mut(world) {
+        s.position = if serials.is_empty() { ahead } else { far };
+        s.velocity = Vec2::ZERO;
+        serials.push(c.serial);
+    }
+    let (threatened, safe) = (serials[0], serials[1]);
+    // One going rigid (100 + 50 us) and one point mass fit; two rigid do not.
+    world.resource_mut::<SimConfig>().rules.budget.frame_budget_ms = 0.2;
+    let level_of = |sim: &mut HeadlessSim, serial: u32| {
+        let world = sim.app.world_mut();
+        world
+            .query::<(&Creature, &Lod, &LevelChoice)>()
+            .iter(world)
+            .find(|(c, ..)| c.serial == serial)
+            .map(|(_, &l, choice)| (l, choice.wanted))
+            .unwrap()
+    };
+    sim.advance_frame();
+    assert_eq!(level_of(&mut sim, threatened).1, Lod::Rigid);
+    assert_eq!(level_of(&mut sim, safe).1, Lod::PointMass);
+    // It becomes rigid (in its flight window, or at once if the puck reaches it first).
+    for _ in 0..15 {
+        sim.advance_frame();
+    }
+    assert_eq!(level_of(&mut sim, threatened).0, Lod::Rigid);
+    assert_eq!(level_of(&mut sim, safe).0, Lod::PointMass);
+}
+
+#[test]
+fn the_budget_policy_with_its_cost_model_is_deterministic() {
+    let run = || {
+        let mut sim = HeadlessSim::new(budget_scene(30, 0.5));
+        sim.run_for(10.0);
+        let mut summary = sim.summary(0.0);
+        summary.realtime_factor = 0.0;
+        (sim.state_digest(), summary)
+    };
+    let (a, b) = (run(), run());
+    assert_eq!(a, b);
+    assert!(a.1.switches.total() > 10, "levels should move: {:?}", a.1.switches);
+}
+
+#[test]
+fn a_budget_too_small_for_the_cheapest_levels_gives_them_and_says_it_was_exceeded() {
+    // 20 point masses alone cost 20 us; the budget is 10.
+    let mut sim = HeadlessSim::new(budget_scene(20, 0.01));
+    sim.run_for(5.0);
+    let summary = sim.summary(0.0);
+    assert_eq!(summary.levels[Lod::PointMass], 20, "{:?}", summary.levels);
+    assert_eq!(summary.switches.total(), 0);
+    let budget = summary.budget.expect("a budget summary");
+    assert!(budget.decisions > 0);
+    assert_eq!(budget.decisions_over_budget, budget.decisions);
+    assert!(budget.predicted_ms_max >= 0.02 - 1e-6, "{budget:?}");
+}
+
+#[test]
+fn a_bad_cost_model_or_a_missing_one_is_refused_naming_the_file_and_the_field() {
+    use crate::assets::{assets_with, edited};
+    let load = |root: std::path::PathBuf| SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap_err();
+    let negative = edited("costs.ron", "rigid_us_per_frame: ", "rigid_us_per_frame: -");
+    let err = load(assets_with("budget_negative_cost", "costs.ron", &negative));
+    let text = err.to_string();
+    assert!(err.file.ends_with("costs.ron"), "{text}");
+    assert!(
+        text.contains("`kinds[0].costs.rigid_us_per_frame`") && text.contains("got -"),
+        "{text}"
+    );
+    let gone = edited("rules/levels.ron", "\"costs.ron\"", "\"gone.ron\"");
+    let err = load(assets_with("budget_missing_costs", "rules/levels.ron", &gone));
+    let text = err.to_string();
+    assert!(err.file.ends_with("rules/levels.ron"), "{text}");
+    assert!(
+        text.contains("`budget.cost_model`") && text.contains("gone.ron"),
+        "{text}"
+    );
+}
