@@ -253,6 +253,9 @@ struct ScenarioArgs {
     /// Overrides the scenario's level rules file.
     #[arg(long)]
     rules: Option<PathBuf>,
+    /// Overrides the scenario's rapier solver iterations per tick (1 to 16).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+    solver_iterations: Option<u32>,
 }
 
 fn non_negative_metres(s: &str) -> Result<f32, String> {
@@ -289,6 +292,9 @@ impl ScenarioArgs {
         }
         if let Some(r) = self.camera_radius {
             config.rules.camera.radius_m = r;
+        }
+        if let Some(n) = self.solver_iterations {
+            config.scenario.solver_iterations = n;
         }
         Ok(config)
     }

@@ -17,6 +17,11 @@ pub struct Scenario {
     /// Steering decisions per second, any that divides `tick_hz` (1 Hz up); the paper's frame
     /// rate is 30.
     pub decision_hz: u32,
+    /// Rapier's solver iterations per tick, 1 to 16 (each is a substep of the tick; 4 when
+    /// left out, rapier's default). Most of a rigid creature's cost is its multibody's mass
+    /// matrix, rebuilt once per iteration: see the README's "The rigid level's cost".
+    #[serde(default = "default_solver_iterations")]
+    pub solver_iterations: u32,
     /// The arena file, relative to the assets folder and inside it.
     pub arena: String,
     pub creatures: Vec<CreatureGroup>,
@@ -47,6 +52,10 @@ impl Scenario {
     }
 }
 
+fn default_solver_iterations() -> u32 {
+    4
+}
+
 /// Most creatures a scenario may hold.
 pub const MAX_CREATURES: u32 = 2_000_000;
 
@@ -69,6 +78,11 @@ impl Validate for Scenario {
                 "must divide tick_hz ({}) evenly, got {}",
                 self.tick_hz, self.decision_hz
             ),
+        );
+        v.require(
+            (1..=16).contains(&self.solver_iterations),
+            "solver_iterations",
+            format!("must be between 1 and 16, got {}", self.solver_iterations),
         );
         v.asset_path("arena", &self.arena);
         v.asset_path("level_rules", &self.level_rules);

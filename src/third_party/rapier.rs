@@ -4,6 +4,9 @@
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
+use crate::SimStart;
+use crate::config::SimConfig;
+
 /// Rapier steps once per simulation tick of `dt` seconds (it keeps its own copy of the step).
 pub fn set_timestep(world: &mut World, dt: f32) {
     world.insert_resource(TimestepMode::Fixed { dt, substeps: 1 });
@@ -29,6 +32,14 @@ pub fn empty_world(world: &mut World) {
     }
 }
 
+/// The scenario's solver iterations per tick.
+fn set_solver_iterations(config: Res<SimConfig>, mut contexts: Query<&mut RapierContextSimulation>) {
+    for mut simulation in &mut contexts {
+        simulation.integration_parameters.num_solver_iterations = config.scenario.solver_iterations as usize;
+    }
+}
+
 pub(super) fn plugin(app: &mut App) {
-    app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule());
+    app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
+        .add_systems(SimStart, set_solver_iterations);
 }

@@ -94,6 +94,26 @@ fn a_negative_mass_is_refused() {
 }
 
 #[test]
+fn solver_iterations_default_to_rapiers_and_out_of_range_are_refused() {
+    assert_eq!(default_config().scenario.solver_iterations, 4);
+    let err = load_error(
+        "solver_iterations",
+        "scenarios/default.ron",
+        &edited(
+            "scenarios/default.ron",
+            "decision_hz: 30,",
+            "decision_hz: 30, solver_iterations: 0,",
+        ),
+    );
+    assert_names(
+        &err,
+        "scenarios/default.ron",
+        "solver_iterations",
+        "between 1 and 16, got 0",
+    );
+}
+
+#[test]
 fn a_nan_is_refused() {
     let err = load_error(
         "nan",
@@ -530,4 +550,18 @@ fn more_creatures_than_the_court_can_hold_are_refused_at_once_with_the_numbers()
         "100010 creatures do not fit",
     );
     assert!(err.to_string().contains("at most about 1032"), "{err}");
+}
+
+#[test]
+fn the_scenarios_solver_iterations_reach_rapier() {
+    let mut config = config_with_hoppers(1);
+    config.scenario.solver_iterations = 2;
+    let mut sim = simlod::headless::HeadlessSim::new(config);
+    let world = sim.app.world_mut();
+    let iterations: Vec<usize> = world
+        .query::<&bevy_rapier3d::prelude::RapierContextSimulation>()
+        .iter(world)
+        .map(|s| s.integration_parameters.num_solver_iterations)
+        .collect();
+    assert_eq!(iterations, [2]);
 }
