@@ -149,10 +149,8 @@ impl<'a> LevelInputs<'a> {
     }
 
     fn camera_level(&self, s: &PlanarState, r: &Radii) -> Lod {
-        let to = s.position - self.camera.position;
-        let distance = to.length();
-        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * r.view_cos;
-        match (in_view, distance <= r.camera) {
+        let distance = s.position.distance(self.camera.position);
+        match (in_view(self.camera, s.position, r.view_cos), distance <= r.camera) {
             (false, _) => Lod::PointMass,
             (true, false) => Lod::Hybrid,
             (true, true) => Lod::Rigid,
@@ -167,6 +165,13 @@ impl<'a> LevelInputs<'a> {
             fixed => fixed.initial_level(&Lod::ALL),
         }
     }
+}
+
+/// Whether `q` lies in the camera's view cone, of half angle `acos(view_cos)`.
+fn in_view(camera: &SimCamera, q: Vec2, view_cos: f32) -> bool {
+    let to = q - camera.position;
+    let distance = to.length();
+    distance < 1e-3 || to.dot(camera.facing) >= distance * view_cos
 }
 
 /// Moves the headless camera behind the creature it follows, facing the puck.
@@ -339,6 +344,30 @@ pub(super) fn plugin(app: &mut App) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_creature_in_view_stays_in_view_until_it_is_the_margin_outside_the_cone() {
+        let mut rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
+        rules.release_margin_deg = 10.0;
+        let camera = SimCamera {
+            facing: Vec2::X,
+            half_view_rad: 30f32.to_radians(),
+            ..default()
+        };
+        let at = |deg: f32| Vec2::from_angle(deg.to_radians()) * 20.0;
+        let entering = Radii::of(&rules, camera.half_view_rad, false);
+        let staying = Radii::of(&rules, camera.half_view_rad, true);
+        // 5 degrees outside the cone: not in view to enter, still in view to stay.
+        assert!(in_view(&camera, at(29.0), entering.view_cos));
+        assert!(!in_view(&camera, at(35.0), entering.view_cos));
+        assert!(in_view(&camera, at(35.0), staying.view_cos));
+        assert!(in_view(&camera, at(-35.0), staying.view_cos));
+        // Past the margin it leaves; with no margin, at once.
+        assert!(!in_view(&camera, at(41.0), staying.view_cos));
+        rules.release_margin_deg = 0.0;
+        let no_margin = Radii::of(&rules, camera.half_view_rad, true);
+        assert!(!in_view(&camera, at(31.0), no_margin.view_cos));
+    }
 
     #[test]
     fn the_area_of_influence_stretches_ahead_of_a_moving_body() {
