@@ -42,20 +42,17 @@ fn run_json_has_the_keys_of_the_summary() {
     }
     assert_eq!(summary["seed"], 3);
     assert!((summary["sim_seconds"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+    let total = |key: &str| -> u64 {
+        summary[key]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|v| v.as_u64().unwrap())
+            .sum()
+    };
     let creatures = summary["creatures"].as_u64().unwrap();
-    let levels: u64 = summary["levels"]
-        .as_object()
-        .unwrap()
-        .values()
-        .map(|v| v.as_u64().unwrap())
-        .sum();
-    assert_eq!(levels, creatures, "every creature is at one level: {summary}");
-    let by_level: u64 = summary["falls_by_level"]
-        .as_object()
-        .unwrap()
-        .values()
-        .map(|v| v.as_u64().unwrap())
-        .sum();
+    assert_eq!(total("levels"), creatures, "every creature is at one level: {summary}");
+    let by_level = total("falls_by_level");
     assert_eq!(by_level, summary["falls"], "every fall is at one level: {summary}");
 }
 
