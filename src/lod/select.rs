@@ -268,7 +268,11 @@ pub(super) fn select_levels(
             choice.wanted = wanted;
         }
     });
-    settled.0 = !policy.is_dynamic() && creatures.iter().all(|(_, lod, _, choice)| *lod == choice.wanted);
+    // Not settled while a creature dwells: its wanted level may still change when the dwell ends.
+    settled.0 = !policy.is_dynamic()
+        && creatures
+            .iter()
+            .all(|(_, lod, _, choice)| *lod == choice.wanted && now - choice.last_switch_s >= rules.min_dwell_s);
 }
 
 /// A new world's creatures, placed as point masses, start at the level the policy gives them

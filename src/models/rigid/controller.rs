@@ -22,6 +22,7 @@ use super::{RigidBodies, RigidPart};
 use crate::SimClock;
 use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
+use crate::gait::GaitPose;
 use crate::lod::AtRigid;
 use crate::outcome::FallQueue;
 
@@ -81,10 +82,16 @@ pub struct Raibert {
     /// The velocity the controller aims at: the desired one, approached no faster than the
     /// creature's acceleration limit, so a sudden change of mind does not trip it.
     pub command: Vec2,
+    /// When the creature entered the rigid level, and each leg's length then: the idle legs'
+    /// servo starts from there (see [`Raibert::spring_target`]).
+    pub entry_s: f32,
+    pub entry_lengths_m: [f32; MAX_LEGS],
 }
 
 impl Raibert {
     /// A controller taking over a creature moving at `velocity` at `gait`'s point of its step.
+    /// Its legs' lengths at entry are, until [`Raibert::entered_in`] says otherwise, where the
+    /// controller wants them.
     pub fn resuming(kind: &KindParams, r: &RigidConfig, velocity: Vec2, gait: &GaitPhase, now: f32) -> Self {
         let total = kind
             .legs
@@ -99,7 +106,7 @@ impl Raibert {
             stance_s = gait.stance_fraction * hop_period_s;
         }
         let last_touchdown_s = now - gait.cycle * hop_period_s;
-        Self {
+        let mut controller = Self {
             phase: StancePhase::Flight,
             stance_leg: usize::from(gait.step) % kind.legs.len(),
             thrust_m: r.controller.thrust_initial_m,
@@ -109,6 +116,21 @@ impl Raibert {
             hop_period_s,
             speed_correction: Vec2::ZERO,
             command: velocity,
+            entry_s: now,
+            entry_lengths_m: [0.0; MAX_LEGS],
+        };
+        let together = kind.steps_per_stride == 1;
+        for (i, leg) in kind.legs.iter().enumerate() {
+            let role = controller.role(i, kind.legs.len(), together);
+            controller.entry_lengths_m[i] = controller.servo_target(leg, r, role, together, now);
+        }
+        controller
+    }
+
+    /// The legs' lengths in the pose the creature entered in.
+    pub fn entered_in(&mut self, pose: &GaitPose) {
+        for (length, leg) in self.entry_lengths_m.iter_mut().zip(pose.legs()) {
+            *length = leg.length_m;
         }
     }
 
@@ -292,13 +314,9 @@ impl Raibert {
     /// The spring rest length a leg in `role` aims at `now`. With legs in turn, from a lift-off
     /// the leg that lifted off shortens, and the one that lands next lengthens, over
     /// `idle_leg_swap_s`: Raibert's leg servo in flight.
-    fn spring_target(&self, leg: &LegConfig, r: &RigidConfig, role: Role, together: bool, now: f32) -> f32 {
+    fn servo_target(&self, leg: &LegConfig, r: &RigidConfig, role: Role, together: bool, now: f32) -> f32 {
         let c = &r.controller;
-        let swapped = if c.idle_leg_swap_s > 0.0 {
-            ((now - self.last_liftoff_s) / c.idle_leg_swap_s).clamp(0.0, 1.0)
-        } else {
-            1.0
-        };
+        let swapped = share_of_swap(r, now - self.last_liftoff_s);
         let retracted = |share: f32| (leg.rest_length_m - c.idle_leg_retract_m * share).max(leg.min_length_m);
         match role {
             Role::Stance if self.phase == StancePhase::Thrust => leg.rest_length_m + self.thrust_m,
@@ -307,6 +325,20 @@ impl Raibert {
             Role::Landing => retracted(1.0 - swapped),
             Role::Idle => retracted(swapped),
         }
+    }
+
+    /// The servo's target, eased in from each leg's length at entry over `idle_leg_swap_s`
+    /// after entering the rigid level: a leg snapped toward a target far from its entry length
+    /// pops what is drawn (issue 15). Quintic: no jump in the target's speed or acceleration.
+    fn spring_target(&self, leg: (usize, &LegConfig), r: &RigidConfig, role: Role, together: bool, now: f32) -> f32 {
+        let (i, leg) = leg;
+        let servo = self.servo_target(leg, r, role, together, now);
+        let eased = share_of_swap(r, now - self.entry_s);
+        if eased >= 1.0 || role == Role::Stance {
+            return servo;
+        }
+        let ease = eased * eased * eased * (eased * (6.0 * eased - 15.0) + 10.0);
+        self.entry_lengths_m[i] + (servo - self.entry_lengths_m[i]) * ease
     }
 
     fn torques(&self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, clock: (f32, f32)) -> Torques {
@@ -358,7 +390,7 @@ impl Raibert {
                     // A hip off the body's centre: the leg's thrust there would roll and pitch
                     // the body each step, so the hip cancels that moment about the centre (not
                     // its yaw: a point foot has no grip to twist on).
-                    let thrust = spring_force(sensed, leg, self.spring_target(leg, r, Role::Stance, together, now));
+                    let thrust = spring_force(sensed, leg, self.spring_target((i, leg), r, Role::Stance, together, now));
                     let moment = sensed.hip.cross(sensed.axis * thrust) * Vec3::new(1.0, 0.0, 1.0);
                     stance_body += twist + moment;
                     out.legs[i] = -attitude_level(s, c) / stance_legs - twist - moment;
@@ -390,6 +422,16 @@ fn course(desired: Vec2, body_rotation: Quat) -> Vec2 {
     desired
         .try_normalize()
         .unwrap_or_else(|| (body_rotation * Vec3::X).xz().normalize_or(Vec2::X))
+}
+
+/// How far the idle legs' servo has gone, `elapsed_s` after it started.
+fn share_of_swap(r: &RigidConfig, elapsed_s: f32) -> f32 {
+    let swap_s = r.controller.idle_leg_swap_s;
+    if swap_s > 0.0 {
+        (elapsed_s / swap_s).clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
 }
 
 /// The stance hip torque that holds the body level (pitch and roll).
@@ -459,7 +501,7 @@ pub(super) fn control_legs(
         for (i, (leg_bodies, leg)) in bodies.legs.iter().zip(&kind.legs).enumerate() {
             let role = raibert.role(i, kind.legs.len(), together);
             let sensed_leg = &sensed.legs[i];
-            let target = raibert.spring_target(leg, r, role, together, now);
+            let target = raibert.spring_target((i, leg), r, role, together, now);
             let push = sensed_leg.axis * spring_force(sensed_leg, leg, target);
             for (part, force, torque) in [
                 (leg_bodies.upper, -push, torques.legs[i]),

@@ -201,8 +201,9 @@ fn pose_of(
 /// The pose a creature enters the rigid level in (paper 3.4: the motion continues): in
 /// flight, the gait table's for its speed and stride phase where its kind has one; else (no
 /// table, or on the ground: a new creature, or a switch forced by a collision) upright at the
-/// height its level last had, the legs at rest length; the body raised if need be so every
-/// foot starts clear of the ground. Also the body's vertical velocity, from the table's change
+/// height its level last had, each leg straight down at the length the controller wants it
+/// (`lengths_m`: with legs in turn, the idle one already shortened); the body raised if need be
+/// so every foot starts clear of the ground. Also the body's vertical velocity, from the table's change
 /// of height over the stride.
 fn entry_pose(
     kind: &KindParams,
@@ -210,6 +211,7 @@ fn entry_pose(
     state: &PlanarState,
     gait: &GaitPhase,
     last: &GaitPose,
+    lengths_m: &[f32; MAX_LEGS],
 ) -> (GaitPose, RigidStart) {
     let speed = state.velocity.length();
     let (mut pose, climb) = match &kind.gait {
@@ -222,9 +224,9 @@ fn entry_pose(
             let (now, next) = (table.pose(speed, stride), table.pose(speed, stride + sample));
             (now, (next.body_height_m - now.body_height_m) * table.sample_hz)
         }
-        // Else the body where the lower level had it, the legs hanging at rest.
+        // Else the body where the lower level had it, the legs hanging straight.
         _ => {
-            let legs: Vec<LegPose> = kind.legs.iter().map(|l| LegPose::straight(l.rest_length_m)).collect();
+            let legs: Vec<LegPose> = lengths_m[..kind.legs.len()].iter().map(|l| LegPose::straight(*l)).collect();
             (GaitPose::new(last.body_height_m, 0.0, 0.0, &legs), 0.0)
         }
     };
@@ -267,9 +269,10 @@ fn enter_rigid(
     };
     let kind = &kinds[creature.kind];
     let Some(r) = &kind.rigid else { return };
-    let (pose, start) = entry_pose(kind, r, state, gait, last);
+    let mut controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
+    let (pose, start) = entry_pose(kind, r, state, gait, last, &controller.entry_lengths_m);
+    controller.entered_in(&pose);
     let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose);
-    let controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
     commands.entity(entity).insert((bodies, controller, start, pose));
 }
 
