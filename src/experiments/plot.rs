@@ -113,6 +113,39 @@ pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel]) -> Result<()
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
+/// The corner for the legend that hides the fewest points: upper right unless data lie there.
+fn legend_corner(p: &Panel, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> SeriesLabelPosition {
+    let fraction = |v: f64, lo: f64, hi: f64, log: bool| {
+        if log {
+            (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    };
+    let points: Vec<(f64, f64)> = p
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter())
+        .map(|&(x, y)| (fraction(x, x0, x1, false), fraction(y, y0, y1, p.log_y)))
+        .collect();
+    // The legend takes about the outer 45 % of the width and 35 % of the height.
+    let hidden = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|(x, y)| (if right { *x > 0.55 } else { *x < 0.45 }) && (if upper { *y > 0.65 } else { *y < 0.35 }))
+            .count()
+    };
+    [
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ]
+    .into_iter()
+    .min_by_key(|(_, right, upper)| hidden(*right, *upper))
+    .map_or(SeriesLabelPosition::UpperRight, |(corner, ..)| corner)
+}
+
 fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> {
     let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
     let (mut x0, mut x1) = range(xs, false);
@@ -126,6 +159,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
         })
     });
     let (y0, y1) = range(ys, p.log_y);
+    let legend = legend_corner(p, (x0, x1), (y0, y1));
     let mut builder = ChartBuilder::on(area);
     builder
         .caption(&p.title, ("sans-serif", 20))
@@ -200,7 +234,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
                 .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperRight)
+                .position(legend)
                 .draw()?;
         }};
     }

@@ -148,6 +148,27 @@ fn every_experiment_quick_writes_its_files_and_a_plot_that_is_not_blank() {
     );
 }
 
+#[test]
+fn table1_measures_every_kind_it_names_at_every_level() {
+    let out = scratch_dir("table1_kinds");
+    run("table1", &quick(&out)).unwrap();
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("table1.json")).unwrap()).unwrap();
+    for kind in ["hopper", "biped"] {
+        let model = &record["summary"]["kinds"][kind]["ms_per_creature_per_frame"]["model"];
+        let ms = |level: &str| {
+            model[level]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{kind} {level}: {model}"))
+        };
+        for level in ["point_mass", "hybrid", "rigid"] {
+            assert!(ms(level) > 0.0 && ms(level).is_finite(), "{kind} {level}: {model}");
+        }
+    }
+    let csv = std::fs::read_to_string(out.join("table1.csv")).unwrap();
+    assert_eq!(csv.lines().filter(|l| l.starts_with("biped,")).count(), 6, "{csv}");
+}
+
 /// The paper's fig10 set-up at a puck radius that covers the whole court: every creature is
 /// rigid from the start, so the game is the all-rigid one, bit for bit.
 #[test]

@@ -390,7 +390,11 @@ impl Raibert {
                     // A hip off the body's centre: the leg's thrust there would roll and pitch
                     // the body each step, so the hip cancels that moment about the centre (not
                     // its yaw: a point foot has no grip to twist on).
-                    let thrust = spring_force(sensed, leg, self.spring_target((i, leg), r, Role::Stance, together, now));
+                    let thrust = spring_force(
+                        sensed,
+                        leg,
+                        self.spring_target((i, leg), r, Role::Stance, together, now),
+                    );
                     let moment = sensed.hip.cross(sensed.axis * thrust) * Vec3::new(1.0, 0.0, 1.0);
                     stance_body += twist + moment;
                     out.legs[i] = -attitude_level(s, c) / stance_legs - twist - moment;

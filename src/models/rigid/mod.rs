@@ -226,7 +226,10 @@ fn entry_pose(
         }
         // Else the body where the lower level had it, the legs hanging straight.
         _ => {
-            let legs: Vec<LegPose> = lengths_m[..kind.legs.len()].iter().map(|l| LegPose::straight(*l)).collect();
+            let legs: Vec<LegPose> = lengths_m[..kind.legs.len()]
+                .iter()
+                .map(|l| LegPose::straight(*l))
+                .collect();
             (GaitPose::new(last.body_height_m, 0.0, 0.0, &legs), 0.0)
         }
     };
