@@ -311,6 +311,9 @@ struct RadiusSummary {
     mean_collided_all_rigid: f64,
     mean_falls: f64,
     mean_falls_all_rigid: f64,
+    /// Falls under influence minus all rigid, trial by trial: mean and standard error.
+    mean_falls_difference: f64,
+    standard_error_falls_difference: f64,
     mean_rigid: f64,
     wall_s: f64,
     wall_s_all_rigid: f64,
@@ -328,15 +331,18 @@ fn summarise(rows: &[Row]) -> Vec<RadiusSummary> {
             let at: Vec<&Row> = rows.iter().filter(|r| r.puck_radius_m == radius).collect();
             let n = at.len() as f64;
             let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
-            let mean_difference = mean(&|r| r.difference() as f64);
-            let variance_difference = if at.len() > 1 {
-                at.iter()
-                    .map(|r| (r.difference() as f64 - mean_difference).powi(2))
-                    .sum::<f64>()
-                    / (n - 1.0)
-            } else {
-                0.0
+            let variance = |f: &dyn Fn(&Row) -> f64| {
+                let m = mean(f);
+                if at.len() > 1 {
+                    at.iter().map(|r| (f(r) - m).powi(2)).sum::<f64>() / (n - 1.0)
+                } else {
+                    0.0
+                }
             };
+            let difference = |r: &Row| r.difference() as f64;
+            let falls_difference = |r: &Row| r.falls as f64 - r.falls_all_rigid as f64;
+            let mean_difference = mean(&difference);
+            let variance_difference = variance(&difference);
             let wall_s = at.iter().map(|r| r.wall_s).sum::<f64>();
             let wall_s_all_rigid = at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>();
             RadiusSummary {
@@ -348,6 +354,8 @@ fn summarise(rows: &[Row]) -> Vec<RadiusSummary> {
                 mean_collided_all_rigid: mean(&|r| r.collided_all_rigid as f64),
                 mean_falls: mean(&|r| r.falls as f64),
                 mean_falls_all_rigid: mean(&|r| r.falls_all_rigid as f64),
+                mean_falls_difference: mean(&falls_difference),
+                standard_error_falls_difference: (variance(&falls_difference) / n).sqrt(),
                 mean_rigid: mean(&|r| r.mean_rigid),
                 wall_s,
                 wall_s_all_rigid,
@@ -417,14 +425,14 @@ fn finish(mut rows: Vec<Row>, out: &Path, command: &str, scenario: &Path, assets
         "For each puck radius, {n_trials} trials of {seconds} s, each from its own seed, under the influence policy (rules `{}`), \
          each beside the identical trial all rigid; the measure is the paper's, the creatures that collided with the puck or a wall. \
          The difference is influence minus all rigid. Trials ran in parallel, each simulation on one thread; wall times are per trial.\n\n\
-         | radius (m) | trials | difference: mean | variance | collided | collided all rigid | falls | falls all rigid | rigid creatures (mean) | speed-up |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+         | radius (m) | trials | difference: mean | variance | collided | collided all rigid | falls | falls all rigid | falls: difference +- s.e. | rigid creatures (mean) | speed-up |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
         rows.first().map_or("", |r| r.rules.as_str())
     );
     for p in &per_radius {
         let _ = writeln!(
             report,
-            "| {} | {} | {:+.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
+            "| {} | {} | {:+.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:+.2} +- {:.2} | {:.1} | {:.2} |",
             p.puck_radius_m,
             p.trials,
             p.mean_difference,
@@ -433,10 +441,28 @@ fn finish(mut rows: Vec<Row>, out: &Path, command: &str, scenario: &Path, assets
             p.mean_collided_all_rigid,
             p.mean_falls,
             p.mean_falls_all_rigid,
+            p.mean_falls_difference,
+            p.standard_error_falls_difference,
             p.mean_rigid,
             p.speedup
         );
     }
+    // Issue 15: switching must not add falls. Beyond noise: more than two standard errors of
+    // the trial-by-trial difference.
+    let more_falls: Vec<String> = per_radius
+        .iter()
+        .filter(|p| p.mean_falls_difference > 2.0 * p.standard_error_falls_difference)
+        .map(|p| format!("{} m", p.puck_radius_m))
+        .collect();
+    let _ = write!(
+        report,
+        "\nFalls under influence beyond all rigid's by more than two standard errors of the trial-by-trial difference: {}.\n",
+        if more_falls.is_empty() {
+            "at no radius".to_string()
+        } else {
+            more_falls.join(", ")
+        }
+    );
     let _ = write!(
         report,
         "\nThe paper finds the difference flat from 15 to 8 m and falling below 8 m (the hybrid, more agile, collides less). \
