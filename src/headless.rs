@@ -10,6 +10,7 @@ use std::time::Instant;
 use crate::arena::PuckState;
 use crate::config::SimConfig;
 use crate::creature::{Creature, GaitPhase, PlanarState};
+use crate::lod::MeasuredFrame;
 use crate::outcome::{Summary, summarize};
 use crate::{SimClock, SimPlugin};
 
@@ -47,9 +48,13 @@ impl HeadlessSim {
         *self.app.world().resource::<SimClock>()
     }
 
-    /// Runs one frame: `ticks_per_decision` fixed ticks.
+    /// Runs one frame: `ticks_per_decision` fixed ticks. Its wall time is left for the
+    /// budget policy's adaptive mode, which alone reads it.
     pub fn advance_frame(&mut self) {
+        let start = Instant::now();
         self.app.update();
+        let us = start.elapsed().as_secs_f32() * 1e6;
+        self.app.world_mut().resource_mut::<MeasuredFrame>().sim_us_per_decision = Some(us);
     }
 
     /// Runs whole frames until at least `seconds` have been simulated.

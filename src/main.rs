@@ -490,8 +490,16 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
                 b.decisions_over_budget, b.decisions
             )
         };
+        let adaptive = if b.adaptive {
+            format!(
+                " (adaptive, not reproducible: the cost model corrected x {:.2} at the end)",
+                b.correction
+            )
+        } else {
+            String::new()
+        };
         println!(
-            "frame budget {} ms of simulation per 1/30 s: predicted {:.3} ms on average, {:.3} ms at most; {over}",
+            "frame budget {} ms of simulation per 1/30 s: predicted {:.3} ms on average, {:.3} ms at most{adaptive}; {over}",
             b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max
         );
     }

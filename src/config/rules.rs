@@ -84,6 +84,12 @@ pub struct BudgetRules {
     /// A creature's last chosen level counts this share more benefit, so one near the cut-off
     /// does not flicker; 0 to 10.
     pub hysteresis: f32,
+    /// 0 (the default): the cost model alone predicts, and the same files give the same run.
+    /// Above 0, the adaptive mode: the predictions are corrected by the measured simulation
+    /// time of each frame, smoothed over about this many frames; it reads the wall clock, so
+    /// runs are not reproducible. 0 to 10,000 frames.
+    #[serde(default)]
+    pub adaptive_frames: f32,
 }
 
 impl Validate for LevelRules {
@@ -122,6 +128,7 @@ impl Validate for LevelRules {
             }
             v.range("view_half_distance_m", b.view_half_distance_m, 0.01, 10_000.0);
             v.within("hysteresis", b.hysteresis, 0.0, 10.0);
+            v.within("adaptive_frames", b.adaptive_frames, 0.0, 10_000.0);
         });
         let (a, b) = self.flight_window;
         v.range("flight_window.0", a, 0.0, 1.0);

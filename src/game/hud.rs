@@ -15,7 +15,7 @@ use super::scene::{ColourByLevel, srgb};
 use crate::SimClock;
 use crate::config::SimConfig;
 use crate::lod::PopTally;
-use crate::lod::{BudgetTally, LevelPolicy, Lod};
+use crate::lod::{BudgetTally, LevelPolicy, Lod, MeasuredFrame};
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -57,7 +57,12 @@ fn start_timing(mut timing: ResMut<Timing>) {
 
 /// Measured around the fixed loop, outside the simulation: the simulation never reads the
 /// clock.
-fn stop_timing(settings: Res<GameSettings>, clock: Res<SimClock>, mut timing: ResMut<Timing>) {
+fn stop_timing(
+    settings: Res<GameSettings>,
+    clock: Res<SimClock>,
+    mut timing: ResMut<Timing>,
+    mut measured: ResMut<MeasuredFrame>,
+) {
     let Some(start) = timing.ticks_started.take() else {
         return;
     };
@@ -74,6 +79,7 @@ fn stop_timing(settings: Res<GameSettings>, clock: Res<SimClock>, mut timing: Re
         .saturating_sub(std::mem::replace(&mut timing.last_tick, clock.tick));
     if ticks > 0 {
         let per_decision = sim_ms * clock.ticks_per_decision as f32 / ticks as f32;
+        measured.sim_us_per_decision = Some(per_decision * 1e3);
         timing.sim_ms_per_decision += (per_decision - timing.sim_ms_per_decision) * ease;
     }
     if dt > 0.0 {
@@ -229,10 +235,15 @@ fn stats_text(
     if config.scenario.level_policy == LevelPolicy::Budget {
         let _ = write!(
             s,
-            "\nframe budget {:.1} ms per 1/30 s: predicted {:.2} ms, measured {:.2} ms{}",
+            "\nframe budget {:.1} ms per 1/30 s: predicted {:.2} ms, measured {:.2} ms{}{}",
             rules.budget.frame_budget_ms,
             budget.predicted_us / 1e3,
             timing.sim_ms_per_decision,
+            if rules.budget.adaptive_frames > 0.0 {
+                format!("   adaptive: model x {:.2}", budget.correction)
+            } else {
+                String::new()
+            },
             if budget.over_budget > 0 {
                 format!("   over budget at {} decisions", budget.over_budget)
             } else {

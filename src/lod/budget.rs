@@ -13,7 +13,9 @@
 //! (Funkhouser & Sequin, SIGGRAPH '93), so that the predicted cost of the frame stays within
 //! the budget. It starts from the last decision: a creature in its dwell keeps at least its
 //! level, its last chosen level counts `hysteresis` more, and the switch itself still waits
-//! for the flight window (`switch.rs`). No clock is read: the same files give the same run.
+//! for the flight window (`switch.rs`). No clock is read: the same files give the same run,
+//! unless the adaptive mode (`adaptive_frames` above 0) corrects the cost model by measured
+//! frame times, which the game and the headless runner write from outside the simulation.
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
@@ -153,11 +155,35 @@ pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32) -> Al
     }
 }
 
+/// The wall time the last frame's simulation took, per 1/30 s of motion (a decision's ticks),
+/// written from outside the simulation by whoever steps it (the game, the headless runner).
+/// Only the budget policy's adaptive mode reads it.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct MeasuredFrame {
+    pub sim_us_per_decision: Option<f32>,
+}
+
+/// The adaptive mode's correction of the cost model after one more measured frame: the
+/// measured over the predicted time, smoothed over about `frames` frames. A ratio beyond 10
+/// either way (a stalled frame) counts as 10.
+pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32) -> f32 {
+    if model_us <= 0.0 || !measured_us.is_finite() {
+        return correction;
+    }
+    let ratio = (measured_us / model_us).clamp(0.1, 10.0);
+    correction + (ratio - correction) / frames.max(1.0)
+}
+
 /// What the budget policy predicted, decision by decision (the summary and the HUD read it).
-#[derive(Resource, Clone, Debug, Default)]
+#[derive(Resource, Clone, Debug)]
 pub struct BudgetTally {
-    /// The last decision's predicted simulation time of a frame.
+    /// The last decision's predicted simulation time of a frame (the cost model's, times the
+    /// adaptive correction).
     pub predicted_us: f32,
+    /// The same by the cost model alone.
+    pub model_us: f32,
+    /// The adaptive mode's measured over predicted time, smoothed; 1 when it is off.
+    pub correction: f32,
     pub decisions: u64,
     /// Decisions whose predicted frame did not fit the budget even at the cheapest levels
     /// allowed.
@@ -175,6 +201,24 @@ pub struct BudgetSummary {
     pub decisions: u64,
     /// Decisions where even the cheapest levels allowed were predicted over the budget.
     pub decisions_over_budget: u64,
+    /// Whether the adaptive mode corrected the cost model (the run is then not reproducible),
+    /// and its last correction (measured over predicted; 1 when off).
+    pub adaptive: bool,
+    pub correction: f32,
+}
+
+impl Default for BudgetTally {
+    fn default() -> Self {
+        Self {
+            predicted_us: 0.0,
+            model_us: 0.0,
+            correction: 1.0,
+            decisions: 0,
+            over_budget: 0,
+            predicted_sum_us: 0.0,
+            predicted_max_us: 0.0,
+        }
+    }
 }
 
 impl BudgetTally {
@@ -185,15 +229,18 @@ impl BudgetTally {
             predicted_ms_max: self.predicted_max_us / 1e3,
             decisions: self.decisions,
             decisions_over_budget: self.over_budget,
+            adaptive: rules.adaptive_frames > 0.0,
+            correction: self.correction,
         }
     }
 
     fn record(&mut self, a: &Allocation) {
-        self.predicted_us = a.predicted_us;
+        self.model_us = a.predicted_us;
+        self.predicted_us = a.predicted_us * self.correction;
         self.decisions += 1;
         self.over_budget += u64::from(a.exceeded);
-        self.predicted_sum_us += f64::from(a.predicted_us);
-        self.predicted_max_us = self.predicted_max_us.max(a.predicted_us);
+        self.predicted_sum_us += f64::from(self.predicted_us);
+        self.predicted_max_us = self.predicted_max_us.max(self.predicted_us);
     }
 }
 
@@ -326,6 +373,7 @@ fn decide(
     kinds: &KindTable,
     scene: &Scene,
     creatures: &Creatures,
+    budget_us: f32,
 ) -> (Vec<Entity>, Allocation) {
     let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
     let mut rows: Vec<_> = creatures.iter().collect();
@@ -346,8 +394,7 @@ fn decide(
             }
         })
         .collect();
-    let budget = config.rules.budget.frame_budget_ms * 1e3;
-    let allocation = allocate(&candidates, budget, config.rules.budget.hysteresis);
+    let allocation = allocate(&candidates, budget_us, config.rules.budget.hysteresis);
     (rows.iter().map(|r| r.0).collect(), allocation)
 }
 
@@ -388,8 +435,10 @@ struct Inputs<'w> {
 }
 
 impl Inputs<'_> {
-    /// The allocation for every creature now, in the order of their serials.
-    fn decide(&self, creatures: &Creatures) -> (Vec<Entity>, Allocation) {
+    /// The allocation for every creature now, in the order of their serials: within the
+    /// budget as the cost model predicts it, times `correction`.
+    fn decide(&self, creatures: &Creatures, correction: f32) -> (Vec<Entity>, Allocation) {
+        let budget_us = self.config.rules.budget.frame_budget_ms * 1e3 / correction;
         let scene = scene(
             &self.config,
             &self.kinds,
@@ -404,16 +453,28 @@ impl Inputs<'_> {
             &self.kinds,
             &scene,
             creatures,
+            budget_us,
         )
     }
 }
 
 /// At each decision, under the budget policy: every creature's wanted level.
-fn choose_by_budget(inputs: Inputs, mut tally: ResMut<BudgetTally>, mut creatures: Creatures) {
+fn choose_by_budget(
+    inputs: Inputs,
+    measured: Res<MeasuredFrame>,
+    mut tally: ResMut<BudgetTally>,
+    mut creatures: Creatures,
+) {
     if !inputs.clock.is_decision_tick() {
         return;
     }
-    let (entities, allocation) = inputs.decide(&creatures);
+    let frames = inputs.config.rules.budget.adaptive_frames;
+    if frames > 0.0
+        && let Some(measured_us) = measured.sim_us_per_decision
+    {
+        tally.correction = corrected(tally.correction, tally.model_us, measured_us, frames);
+    }
+    let (entities, allocation) = inputs.decide(&creatures, tally.correction);
     tally.record(&allocation);
     for (entity, &level) in entities.iter().zip(&allocation.levels) {
         if let Ok((.., mut choice)) = creatures.get_mut(*entity)
@@ -438,7 +499,7 @@ fn start_by_budget(
         return;
     }
     let now = inputs.clock.seconds() as f32;
-    let (entities, allocation) = inputs.decide(&creatures);
+    let (entities, allocation) = inputs.decide(&creatures, tally.correction);
     for (&entity, &level) in entities.iter().zip(&allocation.levels) {
         let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
             continue;
@@ -455,6 +516,7 @@ fn start_by_budget(
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<BudgetTally>()
+        .init_resource::<MeasuredFrame>()
         .add_systems(SimStart, start_by_budget.after(start_at_selected_levels))
         .add_systems(
             FixedUpdate,
@@ -524,6 +586,21 @@ mod tests {
         let a = allocate(&cs, 160.0, 0.0);
         assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid]);
         assert!(a.predicted_us <= 160.0, "{a:?}");
+    }
+
+    #[test]
+    fn the_adaptive_correction_moves_toward_measured_over_predicted_and_ignores_a_stall() {
+        // Frames measured at twice the prediction: over about 10 frames the correction nears 2.
+        let mut c = 1.0;
+        for _ in 0..50 {
+            c = corrected(c, 1000.0, 2000.0, 10.0);
+        }
+        assert!((c - 2.0).abs() < 0.01, "{c}");
+        // One frame stalled a thousand times over counts as ten times, a tenth of it.
+        let stalled = corrected(2.0, 1000.0, 1e9, 10.0);
+        assert!((stalled - 2.8).abs() < 1e-5, "{stalled}");
+        // Nothing predicted yet: nothing to correct.
+        assert_eq!(corrected(1.5, 0.0, 2000.0, 10.0), 1.5);
     }
 
     #[test]

@@ -9,7 +9,7 @@ use simlod::arena::PuckState;
 use simlod::config::{CostModel, LevelCosts, SimConfig};
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
-use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
+use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod, MeasuredFrame};
 
 /// Costs set here, so that the tests do not move with the machine's calibration.
 const COSTS: LevelCosts = LevelCosts {
@@ -146,6 +146,55 @@ fn a_budget_too_small_for_the_cheapest_levels_gives_them_and_says_it_was_exceede
     assert!(budget.decisions > 0);
     assert_eq!(budget.decisions_over_budget, budget.decisions);
     assert!(budget.predicted_ms_max >= 0.02 - 1e-6, "{budget:?}");
+}
+
+/// Runs `seconds` of a budget scene, telling the policy after each frame that it took
+/// `measured(tally)` microseconds: frame times set here, not the machine's.
+fn with_frames_measured(config: SimConfig, seconds: f64, measured: impl Fn(&BudgetTally) -> f32) -> HeadlessSim {
+    let mut sim = HeadlessSim::new(config);
+    let frames = (seconds * 30.0) as usize;
+    for _ in 0..frames {
+        sim.advance_frame();
+        let us = measured(sim.app.world().resource::<BudgetTally>());
+        sim.app.world_mut().resource_mut::<MeasuredFrame>().sim_us_per_decision = Some(us);
+    }
+    sim
+}
+
+#[test]
+fn the_adaptive_mode_spends_less_where_frames_measure_dearer_than_the_cost_model() {
+    let budget_ms = 0.6;
+    let mut config = budget_scene(30, budget_ms);
+    config.rules.budget.adaptive_frames = 10.0;
+    // Every frame measures three times what the cost model predicted for it.
+    let mut sim = with_frames_measured(config.clone(), 8.0, |t| 3.0 * t.model_us);
+    let tally = sim.app.world().resource::<BudgetTally>().clone();
+    assert!((tally.correction - 3.0).abs() < 0.05, "{tally:?}");
+    // The model's prediction now fits a third of the budget; the corrected one the budget.
+    assert!(tally.model_us <= budget_ms * 1e3 / 3.0 + 1e-3, "{tally:?}");
+    assert!(tally.predicted_us <= budget_ms * 1e3 + 1e-3, "{tally:?}");
+    let summary = sim.summary(0.0);
+    let budget = summary.budget.expect("a budget summary");
+    assert!(budget.adaptive && (budget.correction - 3.0).abs() < 0.05, "{budget:?}");
+    // Off, the same measurements change nothing: fewer rigid creatures only with it on.
+    config.rules.budget.adaptive_frames = 0.0;
+    let mut off = with_frames_measured(config, 8.0, |t| 3.0 * t.model_us);
+    let off_summary = off.summary(0.0);
+    assert_eq!(off_summary.budget.unwrap().correction, 1.0);
+    assert!(
+        summary.levels_mean[Lod::Rigid] < off_summary.levels_mean[Lod::Rigid],
+        "rigid on average: adaptive {} against {}",
+        summary.levels_mean[Lod::Rigid],
+        off_summary.levels_mean[Lod::Rigid]
+    );
+}
+
+#[test]
+fn with_the_adaptive_mode_off_measured_frame_times_do_not_change_the_run() {
+    let config = budget_scene(30, 0.5);
+    let mut slow = with_frames_measured(config.clone(), 5.0, |_| 1e6);
+    let mut fast = with_frames_measured(config, 5.0, |_| 1.0);
+    assert_eq!(slow.state_digest(), fast.state_digest());
 }
 
 #[test]
