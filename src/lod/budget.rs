@@ -17,18 +17,17 @@
 //! unless the adaptive mode (`adaptive_frames` above 0) corrects the cost model by measured
 //! frame times, which the game and the headless runner write from outside the simulation.
 
-use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 use serde::Serialize;
 
-use super::select::{LevelChoice, SimCamera, select_levels, start_at_selected_levels};
+use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start_at_selected_levels};
 use super::{LevelPolicy, Lod};
 use crate::arena::{Court, PuckState};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState, starting_gait};
 use crate::gait::GaitPose;
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage, SimStart};
+use crate::{SimStage, SimStart};
 
 /// One creature as the knapsack sees it.
 #[derive(Clone, Debug)]
@@ -422,19 +421,7 @@ fn scene<'a>(
     }
 }
 
-/// What a decision reads besides the creatures.
-#[derive(SystemParam)]
-struct Inputs<'w> {
-    clock: Res<'w, SimClock>,
-    config: Res<'w, SimConfig>,
-    kinds: Res<'w, KindTable>,
-    puck: Res<'w, PuckState>,
-    court: Res<'w, Court>,
-    grid: Res<'w, NeighbourGrid>,
-    camera: Res<'w, SimCamera>,
-}
-
-impl Inputs<'_> {
+impl DecisionInputs<'_> {
     /// The allocation for every creature now, in the order of their serials: within the
     /// budget as the cost model predicts it, times `correction`.
     fn decide(&self, creatures: &Creatures, correction: f32) -> (Vec<Entity>, Allocation) {
@@ -460,7 +447,7 @@ impl Inputs<'_> {
 
 /// At each decision, under the budget policy: every creature's wanted level.
 fn choose_by_budget(
-    inputs: Inputs,
+    inputs: DecisionInputs,
     measured: Res<MeasuredFrame>,
     mut tally: ResMut<BudgetTally>,
     mut creatures: Creatures,
@@ -489,7 +476,7 @@ fn choose_by_budget(
 /// the levels the budget gives them (in that level's rhythm and pose).
 fn start_by_budget(
     mut commands: Commands,
-    inputs: Inputs,
+    inputs: DecisionInputs,
     mut tally: ResMut<BudgetTally>,
     mut creatures: Creatures,
     mut gaits: Query<(&mut GaitPhase, &mut GaitPose)>,

@@ -18,6 +18,7 @@
 //! Hysteresis: entering an area uses its radius; leaving it takes `release_margin_m` more,
 //! and a creature keeps a new level at least `min_dwell_s`.
 
+use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::{LevelPolicy, Lod};
@@ -96,6 +97,34 @@ impl Radii {
     }
 }
 
+/// What a decision on levels reads besides the creatures (every policy's).
+#[derive(SystemParam)]
+pub(super) struct DecisionInputs<'w> {
+    pub clock: Res<'w, SimClock>,
+    pub config: Res<'w, SimConfig>,
+    pub kinds: Res<'w, KindTable>,
+    pub puck: Res<'w, PuckState>,
+    pub court: Res<'w, Court>,
+    pub grid: Res<'w, NeighbourGrid>,
+    pub camera: Res<'w, SimCamera>,
+}
+
+impl DecisionInputs<'_> {
+    /// The areas of influence and the camera rule, over these inputs.
+    fn rules(&self) -> LevelInputs<'_> {
+        let rules = &self.config.rules;
+        let top_speed = self.kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
+        LevelInputs {
+            rules,
+            puck: &self.puck,
+            court: &self.court,
+            grid: &self.grid,
+            camera: &self.camera,
+            reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
+        }
+    }
+}
+
 struct LevelInputs<'a> {
     rules: &'a LevelRules,
     puck: &'a PuckState,
@@ -105,26 +134,7 @@ struct LevelInputs<'a> {
     reach_m: f32,
 }
 
-impl<'a> LevelInputs<'a> {
-    fn new(
-        rules: &'a LevelRules,
-        kinds: &KindTable,
-        puck: &'a PuckState,
-        court: &'a Court,
-        grid: &'a NeighbourGrid,
-        camera: &'a SimCamera,
-    ) -> Self {
-        let top_speed = kinds.0.iter().map(|k| k.top_speed_m_per_s).fold(0.0, f32::max);
-        Self {
-            rules,
-            puck,
-            court,
-            grid,
-            camera,
-            reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
-        }
-    }
-
+impl LevelInputs<'_> {
     fn influence_level(&self, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
         let la = self.rules.influence.lookahead_s;
         let near_wall = (self.court.half_extents - s.position.abs()).min_element() <= r.wall;
@@ -220,23 +230,18 @@ fn unsettle_levels(mut settled: ResMut<LevelsSettled>) {
 
 /// At each decision, the level the policy wants for every creature, with hysteresis.
 pub(super) fn select_levels(
-    clock: Res<SimClock>,
-    config: Res<SimConfig>,
-    kinds: Res<KindTable>,
-    puck: Res<PuckState>,
-    court: Res<Court>,
-    grid: Res<NeighbourGrid>,
-    camera: Res<SimCamera>,
+    inputs: DecisionInputs,
     mut settled: ResMut<LevelsSettled>,
     mut creatures: Query<(&Creature, &Lod, &PlanarState, &mut LevelChoice)>,
 ) {
+    let (clock, config, kinds, camera) = (&inputs.clock, &inputs.config, &inputs.kinds, &inputs.camera);
     let policy = config.scenario.level_policy;
     // The budget policy chooses for all creatures at once (`budget.rs`).
     if !clock.is_decision_tick() || policy == LevelPolicy::Budget {
         return;
     }
     let rules = &config.rules;
-    let inputs = LevelInputs::new(rules, &kinds, &puck, &court, &grid, &camera);
+    let levels = inputs.rules();
     let (enter, leave) = (
         Radii::of(rules, camera.half_view_rad, false),
         Radii::of(rules, camera.half_view_rad, true),
@@ -254,8 +259,8 @@ pub(super) fn select_levels(
         Mut<LevelChoice>
     )| {
         let kind = &kinds[c.kind];
-        let up = kind.best_level(inputs.level(policy, c, s, &enter));
-        let down = kind.best_level(inputs.level(policy, c, s, &leave));
+        let up = kind.best_level(levels.level(policy, c, s, &enter));
+        let down = kind.best_level(levels.level(policy, c, s, &leave));
         let dwelling = now - choice.last_switch_s < rules.min_dwell_s;
         let wanted = if up > *lod {
             up
@@ -281,13 +286,7 @@ pub(super) fn select_levels(
 /// so that a puck area covering the court is the all-rigid game bit for bit.
 pub(super) fn start_at_selected_levels(
     mut commands: Commands,
-    clock: Res<SimClock>,
-    config: Res<SimConfig>,
-    kinds: Res<KindTable>,
-    puck: Res<PuckState>,
-    court: Res<Court>,
-    grid: Res<NeighbourGrid>,
-    camera: Res<SimCamera>,
+    inputs: DecisionInputs,
     mut creatures: Query<(
         Entity,
         &Creature,
@@ -298,13 +297,14 @@ pub(super) fn start_at_selected_levels(
         &mut LevelChoice,
     )>,
 ) {
+    let (clock, config, kinds, camera) = (&inputs.clock, &inputs.config, &inputs.kinds, &inputs.camera);
     let policy = config.scenario.level_policy;
-    let inputs = LevelInputs::new(&config.rules, &kinds, &puck, &court, &grid, &camera);
+    let levels = inputs.rules();
     let enter = Radii::of(&config.rules, camera.half_view_rad, false);
     for (entity, c, &lod, s, mut gait, mut pose, mut choice) in &mut creatures {
         let kind = &kinds[c.kind];
         let level = if policy.is_dynamic() {
-            kind.best_level(inputs.level(policy, c, s, &enter))
+            kind.best_level(levels.level(policy, c, s, &enter))
         } else {
             policy.initial_level(&kind.levels)
         };
