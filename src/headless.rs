@@ -10,7 +10,7 @@ use std::time::Instant;
 use crate::arena::PuckState;
 use crate::config::SimConfig;
 use crate::creature::{Creature, GaitPhase, PlanarState};
-use crate::lod::MeasuredFrame;
+use crate::lod::BudgetTally;
 use crate::outcome::{Summary, summarize};
 use crate::{SimClock, SimPlugin};
 
@@ -54,7 +54,7 @@ impl HeadlessSim {
         let start = Instant::now();
         self.app.update();
         let us = start.elapsed().as_secs_f32() * 1e6;
-        self.app.world_mut().resource_mut::<MeasuredFrame>().sim_us_per_decision = Some(us);
+        self.app.world_mut().resource_mut::<BudgetTally>().measured_us = Some(us);
     }
 
     /// Runs whole frames until at least `seconds` have been simulated.

@@ -15,7 +15,7 @@ use super::scene::{ColourByLevel, srgb};
 use crate::SimClock;
 use crate::config::SimConfig;
 use crate::lod::PopTally;
-use crate::lod::{BudgetTally, LevelPolicy, Lod, MeasuredFrame};
+use crate::lod::{BudgetTally, LevelPolicy, Lod};
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -61,7 +61,7 @@ fn stop_timing(
     settings: Res<GameSettings>,
     clock: Res<SimClock>,
     mut timing: ResMut<Timing>,
-    mut measured: ResMut<MeasuredFrame>,
+    mut budget: ResMut<BudgetTally>,
 ) {
     let Some(start) = timing.ticks_started.take() else {
         return;
@@ -79,7 +79,7 @@ fn stop_timing(
         .saturating_sub(std::mem::replace(&mut timing.last_tick, clock.tick));
     if ticks > 0 {
         let per_decision = sim_ms * clock.ticks_per_decision as f32 / ticks as f32;
-        measured.sim_us_per_decision = Some(per_decision * 1e3);
+        budget.measured_us = Some(per_decision * 1e3);
         timing.sim_ms_per_decision += (per_decision - timing.sim_ms_per_decision) * ease;
     }
     if dt > 0.0 {

@@ -154,14 +154,6 @@ pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32) -> Al
     }
 }
 
-/// The wall time the last frame's simulation took, per 1/30 s of motion (a decision's ticks),
-/// written from outside the simulation by whoever steps it (the game, the headless runner).
-/// Only the budget policy's adaptive mode reads it.
-#[derive(Resource, Clone, Copy, Debug, Default)]
-pub struct MeasuredFrame {
-    pub sim_us_per_decision: Option<f32>,
-}
-
 /// The adaptive mode's correction of the cost model after one more measured frame: the
 /// measured over the predicted time, smoothed over about `frames` frames. A ratio beyond 10
 /// either way (a stalled frame) counts as 10.
@@ -183,6 +175,12 @@ pub struct BudgetTally {
     pub model_us: f32,
     /// The adaptive mode's measured over predicted time, smoothed; 1 when it is off.
     pub correction: f32,
+    /// The wall time the last frame's simulation took, per 1/30 s of motion (a decision's
+    /// ticks), written from outside the simulation by whoever steps it (the game, the headless
+    /// runner). Only the adaptive mode reads it. (Here and not a resource of its own: a new
+    /// resource is a new entity, which moves the rigid bodies' entity ids and so rapier's
+    /// rounding.)
+    pub measured_us: Option<f32>,
     pub decisions: u64,
     /// Decisions whose predicted frame did not fit the budget even at the cheapest levels
     /// allowed.
@@ -212,6 +210,7 @@ impl Default for BudgetTally {
             predicted_us: 0.0,
             model_us: 0.0,
             correction: 1.0,
+            measured_us: None,
             decisions: 0,
             over_budget: 0,
             predicted_sum_us: 0.0,
@@ -446,18 +445,13 @@ impl DecisionInputs<'_> {
 }
 
 /// At each decision, under the budget policy: every creature's wanted level.
-fn choose_by_budget(
-    inputs: DecisionInputs,
-    measured: Res<MeasuredFrame>,
-    mut tally: ResMut<BudgetTally>,
-    mut creatures: Creatures,
-) {
+fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut creatures: Creatures) {
     if !inputs.clock.is_decision_tick() {
         return;
     }
     let frames = inputs.config.rules.budget.adaptive_frames;
     if frames > 0.0
-        && let Some(measured_us) = measured.sim_us_per_decision
+        && let Some(measured_us) = tally.measured_us
     {
         tally.correction = corrected(tally.correction, tally.model_us, measured_us, frames);
     }
@@ -503,7 +497,6 @@ fn start_by_budget(
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<BudgetTally>()
-        .init_resource::<MeasuredFrame>()
         .add_systems(SimStart, start_by_budget.after(start_at_selected_levels))
         .add_systems(
             FixedUpdate,

@@ -10,7 +10,7 @@ mod select;
 mod switch;
 
 pub use blend::{Drawn, DrawnBefore, Pop, PopSummary, PopTally, Spread, SwitchBlend, SwitchProbe, drawn};
-pub use budget::{Allocation, BudgetSummary, BudgetTally, Candidate, MeasuredFrame, allocate, corrected};
+pub use budget::{Allocation, BudgetSummary, BudgetTally, Candidate, allocate, corrected};
 pub use select::{CameraFromView, LevelChoice, SimCamera, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 

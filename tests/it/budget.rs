@@ -9,7 +9,7 @@ use simlod::arena::PuckState;
 use simlod::config::{CostModel, LevelCosts, SimConfig};
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
-use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod, MeasuredFrame};
+use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
 
 /// Costs set here, so that the tests do not move with the machine's calibration.
 const COSTS: LevelCosts = LevelCosts {
@@ -156,7 +156,7 @@ fn with_frames_measured(config: SimConfig, seconds: f64, measured: impl Fn(&Budg
     for _ in 0..frames {
         sim.advance_frame();
         let us = measured(sim.app.world().resource::<BudgetTally>());
-        sim.app.world_mut().resource_mut::<MeasuredFrame>().sim_us_per_decision = Some(us);
+        sim.app.world_mut().resource_mut::<BudgetTally>().measured_us = Some(us);
     }
     sim
 }
