@@ -18,7 +18,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::arena::{Ground, Puck, Wall};
-use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
+use crate::config::{LegConfig, MAX_LEGS, RigidConfig, RigidJoints};
 use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::{GaitPose, LegPose};
 use crate::lod::AtRigid;
@@ -80,12 +80,12 @@ fn leg_length_range_m(leg: &LegConfig, r: &RigidConfig) -> (f32, f32) {
 const LEG_STOP_BEYOND_THRUST_M: f32 = 0.02;
 
 /// The physics components every part shares.
-fn part(creature: Entity, transform: Transform) -> impl Bundle {
+fn part(creature: Entity, transform: Transform, velocity: Vec3) -> impl Bundle {
     (
         RigidPart { creature },
         RigidBody::Dynamic,
         transform,
-        Velocity::zero(),
+        Velocity::linear(velocity),
         ExternalForce::default(),
         Sleeping::disabled(),
         ActiveEvents::COLLISION_EVENTS,
@@ -105,8 +105,19 @@ pub struct RigidStart {
     pub velocity: Vec3,
 }
 
+/// Joins `child` to `parent` as the kind's rigid section says: on one multibody tree, or by
+/// an impulse joint.
+fn join(commands: &mut Commands, joints: RigidJoints, parent: Entity, child: Entity, joint: TypedJoint) {
+    let mut child = commands.entity(child);
+    match joints {
+        RigidJoints::Multibody => child.insert(MultibodyJoint::new(parent, joint)),
+        RigidJoints::Impulse => child.insert(ImpulseJoint::new(parent, joint)),
+    };
+}
+
 /// Builds the bodies of a creature at the rigid level in `pose`, facing its heading at its
-/// planar position, the body's centre at the pose's body height.
+/// planar position, the body's centre at the pose's body height. Free bodies (impulse joints)
+/// start at `velocity`; a multibody starts at rest and is set moving by [`RigidStart`].
 pub fn spawn_bodies(
     commands: &mut Commands,
     creature: Entity,
@@ -114,7 +125,12 @@ pub fn spawn_bodies(
     r: &RigidConfig,
     state: &PlanarState,
     pose: &GaitPose,
+    velocity: Vec3,
 ) -> RigidBodies {
+    let velocity = match r.joints {
+        RigidJoints::Multibody => Vec3::ZERO,
+        RigidJoints::Impulse => velocity,
+    };
     let body_rotation = pose.body_rotation(state.heading);
     let centre = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
     let (hx, hy, hz) = r.body_half_extents_m;
@@ -124,6 +140,7 @@ pub fn spawn_bodies(
             part(
                 creature,
                 Transform::from_translation(centre).with_rotation(body_rotation),
+                velocity,
             ),
             Collider::cuboid(hx, hy, hz),
             ColliderMassProperties::Mass(kind.mass_kg),
@@ -147,21 +164,29 @@ pub fn spawn_bodies(
             let upper = commands
                 .spawn((
                     Name::new("creature upper leg"),
-                    part(creature, Transform::from_translation(hip).with_rotation(leg_rotation)),
+                    part(
+                        creature,
+                        Transform::from_translation(hip).with_rotation(leg_rotation),
+                        velocity,
+                    ),
                     Collider::compound(vec![(
                         Vec3::new(0.0, -upper_len / 2.0, 0.0),
                         Quat::IDENTITY,
                         Collider::capsule_y(upper_len / 2.0 - leg.radius_m, leg.radius_m),
                     )]),
                     ColliderMassProperties::Mass(leg.upper_mass_kg),
-                    MultibodyJoint::new(body, hip_joint.into()),
                 ))
                 .id();
+            join(commands, r.joints, body, upper, hip_joint.into());
             let shank = leg.lower_length_m - leg.foot_radius_m;
             let lower = commands
                 .spawn((
                     Name::new("creature lower leg"),
-                    part(creature, Transform::from_translation(foot).with_rotation(leg_rotation)),
+                    part(
+                        creature,
+                        Transform::from_translation(foot).with_rotation(leg_rotation),
+                        velocity,
+                    ),
                     Collider::compound(vec![
                         (Vec3::ZERO, Quat::IDENTITY, Collider::ball(leg.foot_radius_m)),
                         (
@@ -175,9 +200,9 @@ pub fn spawn_bodies(
                         coefficient: leg.foot_friction,
                         combine_rule: CoefficientCombineRule::Max,
                     },
-                    MultibodyJoint::new(upper, leg_joint(leg, r).into()),
                 ))
                 .id();
+            join(commands, r.joints, upper, lower, leg_joint(leg, r).into());
             LegBodies { upper, lower }
         })
         .collect();
@@ -268,9 +293,13 @@ fn enter_rigid(
     let kind = &kinds[creature.kind];
     let Some(r) = &kind.rigid else { return };
     let (pose, start) = entry_pose(kind, r, state, gait, last);
-    let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose);
+    let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose, start.velocity);
     let controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
-    commands.entity(entity).insert((bodies, controller, start, pose));
+    let mut creature = commands.entity(entity);
+    creature.insert((bodies, controller, pose));
+    if r.joints == RigidJoints::Multibody {
+        creature.insert(start);
+    }
 }
 
 /// Leaving the rigid level, or the world: the bodies and the controller go.
