@@ -105,14 +105,21 @@ pub struct RigidStart {
     pub velocity: Vec3,
 }
 
-/// Joins `child` to `parent` as the kind's rigid section says: on one multibody tree, or by
-/// an impulse joint.
-fn join(commands: &mut Commands, joints: RigidJoints, parent: Entity, child: Entity, joint: TypedJoint) {
-    let mut child = commands.entity(child);
+/// Spawns a part joined to `parent` as the kind's rigid section says: on one multibody tree,
+/// or by an impulse joint. The joint comes in the part's one bundle, as the multibody always
+/// did: the multibody's rounding depends on how components arrive (a creature's inserts split
+/// in two changed the shipped gait tables).
+fn spawn_joined(
+    commands: &mut Commands,
+    joints: RigidJoints,
+    part: impl Bundle,
+    parent: Entity,
+    joint: TypedJoint,
+) -> Entity {
     match joints {
-        RigidJoints::Multibody => child.insert(MultibodyJoint::new(parent, joint)),
-        RigidJoints::Impulse => child.insert(ImpulseJoint::new(parent, joint)),
-    };
+        RigidJoints::Multibody => commands.spawn((part, MultibodyJoint::new(parent, joint))).id(),
+        RigidJoints::Impulse => commands.spawn((part, ImpulseJoint::new(parent, joint))).id(),
+    }
 }
 
 /// Builds the bodies of a creature at the rigid level in `pose`, facing its heading at its
@@ -161,8 +168,10 @@ pub fn spawn_bodies(
                 .build();
             hip_joint.set_contacts_enabled(false);
             let upper_len = leg.upper_length_m;
-            let upper = commands
-                .spawn((
+            let upper = spawn_joined(
+                commands,
+                r.joints,
+                (
                     Name::new("creature upper leg"),
                     part(
                         creature,
@@ -175,12 +184,15 @@ pub fn spawn_bodies(
                         Collider::capsule_y(upper_len / 2.0 - leg.radius_m, leg.radius_m),
                     )]),
                     ColliderMassProperties::Mass(leg.upper_mass_kg),
-                ))
-                .id();
-            join(commands, r.joints, body, upper, hip_joint.into());
+                ),
+                body,
+                hip_joint.into(),
+            );
             let shank = leg.lower_length_m - leg.foot_radius_m;
-            let lower = commands
-                .spawn((
+            let lower = spawn_joined(
+                commands,
+                r.joints,
+                (
                     Name::new("creature lower leg"),
                     part(
                         creature,
@@ -200,9 +212,10 @@ pub fn spawn_bodies(
                         coefficient: leg.foot_friction,
                         combine_rule: CoefficientCombineRule::Max,
                     },
-                ))
-                .id();
-            join(commands, r.joints, upper, lower, leg_joint(leg, r).into());
+                ),
+                upper,
+                leg_joint(leg, r).into(),
+            );
             LegBodies { upper, lower }
         })
         .collect();
@@ -295,11 +308,12 @@ fn enter_rigid(
     let (pose, start) = entry_pose(kind, r, state, gait, last);
     let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose, start.velocity);
     let controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
+    // Free bodies start moving as spawned; a multibody is set moving by `start_multibodies`.
     let mut creature = commands.entity(entity);
-    creature.insert((bodies, controller, pose));
-    if r.joints == RigidJoints::Multibody {
-        creature.insert(start);
-    }
+    match r.joints {
+        RigidJoints::Multibody => creature.insert((bodies, controller, start, pose)),
+        RigidJoints::Impulse => creature.insert((bodies, controller, pose)),
+    };
 }
 
 /// Leaving the rigid level, or the world: the bodies and the controller go.
