@@ -113,6 +113,21 @@ pub struct RigidConfig {
     /// `*_kd_*` 0 to 1e4, torques 0 to 1e4 N m, speeds 0 to 50 m/s, as each field says.
     pub controller: RaibertConfig,
     pub fall: FallConfig,
+    /// How rapier joins the bodies: `Multibody` (the default) or `Impulse`.
+    #[serde(default)]
+    pub joints: RigidJoints,
+}
+
+/// How the rigid model's bodies are joined in rapier.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum RigidJoints {
+    /// One multibody (reduced-coordinate) joint tree per creature: the joints hold exactly,
+    /// but rapier rebuilds the tree's mass matrix at each solver iteration.
+    #[default]
+    Multibody,
+    /// Free bodies held together by impulse joints, solved with the contacts: cheaper, and
+    /// the joints give a little under load.
+    Impulse,
 }
 
 /// Raibert's three decoupled controllers (Legged Robots That Balance, 1986).

@@ -16,7 +16,8 @@ mod validate;
 pub use arena::{ArenaConfig, PuckConfig};
 pub use costs::{CostModel, KindCosts, LevelCosts};
 pub use creature::{
-    BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, Stance, SteeringConfig,
+    BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints, Stance,
+    SteeringConfig,
 };
 pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
 pub use loader::{RonAssetLoader, load_file, parse_ron};

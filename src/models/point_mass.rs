@@ -114,11 +114,12 @@ pub(super) fn plugin(app: &mut App) {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::config::SteeringConfig;
 
-    fn kind() -> KindParams {
+    /// A hopper-sized kind: 0.3 m, 10 kg, 3 m/s, 2 m/s^2.
+    pub(crate) fn kind() -> KindParams {
         KindParams {
             radius_m: 0.3,
             mass_kg: 10.0,

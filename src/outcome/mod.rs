@@ -7,7 +7,8 @@
 //! slowed; it shoves the creature along. A creature falls when the normal speed of an impact
 //! exceeds its `fall_impact_speed_m_per_s`. A fallen creature is removed and a new one of
 //! its kind respawns in a free part of the court, so the count stays constant (section 3).
-//! Puck and wall contacts are checked every tick; contacts between creatures at each
+//! Puck and wall contacts are checked every tick, for the creatures that could reach either
+//! before the next decision (chosen at each decision); contacts between creatures at each
 //! steering decision, through the spatial index.
 
 mod counts;
@@ -15,6 +16,7 @@ mod counts;
 pub use counts::{Counts, Key, SwitchCounts};
 
 use bevy::prelude::*;
+use bevy::utils::Parallel;
 use serde::Serialize;
 use std::sync::Mutex;
 
@@ -24,7 +26,8 @@ use crate::creature::{
     Creature, GaitPhase, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
 };
 use crate::lod::{
-    AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, Lod, PopSummary, PopTally, SwitchTally,
+    AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, LevelSwitched, Lod, PopSummary, PopTally,
+    SwitchTally,
 };
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart, WorldRng};
@@ -176,6 +179,51 @@ fn collide_point_mass(
     impact
 }
 
+/// The planar creatures that could reach the puck or a wall before the next decision, chosen
+/// at each decision; between decisions only these are checked. The others cannot touch
+/// either in that time, so the outcome is the one of checking every creature every tick.
+/// Kept by the system itself: a resource or an observer would be one more entity, and the
+/// rigid level's rounding depends on the entities' ids.
+#[derive(Default)]
+struct NearPuckOrWall {
+    /// Chosen at the decision, sorted; creatures switched down from rigid since are added.
+    near: Vec<Entity>,
+    /// The puck's position at the decision, and how far it can go before the next one.
+    puck_from: Vec2,
+    puck_reach_m: f32,
+    /// Respawns counted so far: a creature respawned since the decision starts anywhere.
+    respawns: u64,
+    /// A respawn, or the puck going farther than its reach (shoved in rapier): every creature
+    /// is checked until the next decision.
+    check_all: bool,
+}
+
+/// Slack on each reach for the rounding of positions summed over a frame's ticks (an f32
+/// position 1,500 m from the centre rounds by about 0.1 mm a tick).
+const REACH_SLACK_M: f32 = 0.01;
+
+/// Whether a creature, at its state after this decision's contacts, could reach the puck or a
+/// wall within `frame_s`. A planar body's speed between decisions stays below the larger of its
+/// speed now and its top speed (`step_planar` moves it toward a target within the top speed).
+fn could_reach_puck_or_wall(
+    state: &PlanarState,
+    record: &CollisionRecord,
+    kind: &KindParams,
+    puck: &PuckState,
+    puck_reach_m: f32,
+    half: Vec2,
+    frame_s: f32,
+) -> bool {
+    let reach = state.velocity.length().max(kind.top_speed_m_per_s) * frame_s + REACH_SLACK_M;
+    let r = kind.radius_m;
+    record.touching[Obstacle::Puck as usize]
+        || record.touching[Obstacle::Wall as usize]
+        || state.position.distance(puck.position) - puck.radius_m - r <= reach + puck_reach_m
+        || (state.position.abs() + Vec2::splat(reach + r)).cmpge(half).any()
+}
+
+/// Puck, wall and (at each decision) creature contacts of the planar creatures.
+#[allow(clippy::too_many_arguments)]
 fn detect_collisions(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
@@ -184,9 +232,43 @@ fn detect_collisions(
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
+    tally: Res<Tally>,
+    mut switched: MessageReader<LevelSwitched>,
+    mut watch: Local<NearPuckOrWall>,
+    mut chosen: Local<Parallel<Vec<Entity>>>,
     mut creatures: Query<(Entity, &Creature, &mut PlanarState, &mut CollisionRecord), Without<AtRigid>>,
 ) {
-    let grid = clock.is_decision_tick().then_some(&*grid);
+    let collide = |entity, creature: &Creature, state: &mut PlanarState, record: &mut CollisionRecord, grid| {
+        let kind = &kinds[creature.kind];
+        let impact = collide_point_mass(creature, state, record, kind, &puck, &court, grid);
+        if impact > kind.fall_impact_speed_m_per_s {
+            falls.push(creature.serial, entity);
+        }
+    };
+    let decision = clock.is_decision_tick();
+    if !decision {
+        let watch = &mut *watch;
+        watch.check_all |=
+            tally.respawns != watch.respawns || puck.position.distance(watch.puck_from) > watch.puck_reach_m;
+        let down = switched.read().filter(|s| s.from == Lod::Rigid).map(|s| s.creature);
+        let before = watch.near.len();
+        watch.near.extend(down);
+        if watch.near.len() > before {
+            watch.near.sort_unstable();
+            watch.near.dedup();
+        }
+        if !watch.check_all {
+            for &entity in &watch.near {
+                if let Ok((entity, creature, mut state, mut record)) = creatures.get_mut(entity) {
+                    collide(entity, creature, &mut state, &mut record, None);
+                }
+            }
+            return;
+        }
+    }
+    let frame_s = clock.dt * clock.ticks_per_decision as f32;
+    let puck_reach_m = config.arena.puck.speed_m_per_s * frame_s;
+    let chosen_now = &*chosen;
     for_each_creature!(config.scenario.creature_count(), creatures, |(
         entity,
         creature,
@@ -198,12 +280,24 @@ fn detect_collisions(
         Mut<PlanarState>,
         Mut<CollisionRecord>
     )| {
+        collide(entity, creature, &mut state, &mut record, decision.then_some(&*grid));
         let kind = &kinds[creature.kind];
-        let impact = collide_point_mass(creature, &mut state, &mut record, kind, &puck, &court, grid);
-        if impact > kind.fall_impact_speed_m_per_s {
-            falls.push(creature.serial, entity);
+        if decision && could_reach_puck_or_wall(&state, &record, kind, &puck, puck_reach_m, court.half_extents, frame_s)
+        {
+            chosen_now.borrow_local_mut().push(entity);
         }
     });
+    if decision {
+        switched.clear();
+        let watch = &mut *watch;
+        watch.near.clear();
+        chosen.drain_into(&mut watch.near);
+        watch.near.sort_unstable();
+        watch.puck_from = puck.position;
+        watch.puck_reach_m = puck_reach_m;
+        watch.respawns = tally.respawns;
+        watch.check_all = false;
+    }
 }
 
 /// Removes the fallen and starts a new creature of the same kind in a free spot.
@@ -365,4 +459,57 @@ pub(super) fn plugin(app: &mut App) {
             FixedUpdate,
             (respawn_fallen, advance_clock).chain().in_set(SimStage::Outcome),
         );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::point_mass::tests::kind;
+
+    #[test]
+    fn only_a_creature_that_could_reach_the_puck_or_a_wall_within_a_frame_is_watched() {
+        // 3 m/s top speed and a 5 m/s puck for 1/30 s: 0.1 + 0.167 m, and 1 cm of slack.
+        let (k, frame_s, puck_reach) = (kind(), 1.0 / 30.0, 5.0 / 30.0);
+        let puck = PuckState {
+            position: Vec2::ZERO,
+            velocity: Vec2::X * 5.0,
+            radius_m: 2.0,
+        };
+        let half = Vec2::new(30.0, 20.0);
+        let near = |x: f32, y: f32, speed: f32| {
+            let state = PlanarState {
+                position: Vec2::new(x, y),
+                velocity: Vec2::Y * speed,
+                ..default()
+            };
+            could_reach_puck_or_wall(
+                &state,
+                &CollisionRecord::default(),
+                &k,
+                &puck,
+                puck_reach,
+                half,
+                frame_s,
+            )
+        };
+        // The rims 0.26 m apart: met within the frame; 0.3 m apart: not.
+        assert!(near(2.56, 0.0, 0.0));
+        assert!(!near(2.6, 0.0, 0.0));
+        // The wall 0.1 m away: reached at top speed; 0.2 m: not, unless shoved faster.
+        assert!(near(0.0, 19.6, 0.0));
+        assert!(!near(0.0, 19.5, 0.0));
+        assert!(near(0.0, 19.5, 7.0));
+        // Touching one already: watched, to note the contact's end.
+        let record = CollisionRecord {
+            touching: [false, true, false],
+            ..default()
+        };
+        let far = PlanarState {
+            position: Vec2::splat(10.0),
+            ..default()
+        };
+        assert!(could_reach_puck_or_wall(
+            &far, &record, &k, &puck, puck_reach, half, frame_s
+        ));
+    }
 }

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use std::path::{Path, PathBuf};
 
 use crate::support::*;
-use simlod::config::{ArenaConfig, ConfigError, CreatureDef, Scenario, SimConfig, load_file};
+use simlod::config::{ArenaConfig, ConfigError, CreatureDef, RigidJoints, Scenario, SimConfig, load_file};
 
 /// A copy of the shipped assets in a scratch folder, with one file replaced.
 pub(crate) fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
@@ -76,6 +76,29 @@ fn a_value_of_the_wrong_type_is_named_by_its_whole_path() {
         &edited("creatures/hopper.ron", "mass_kg: 10.0,", "mass_kg: \"heavy\","),
     );
     assert_names(&err, "creatures/hopper.ron", "body.mass_kg", "line");
+}
+
+#[test]
+fn the_rigid_joints_are_a_multibody_unless_the_file_says_impulse_and_others_are_named() {
+    let kinds = |config: &SimConfig| -> Vec<RigidJoints> {
+        config.kinds.iter().map(|k| k.rigid.as_ref().unwrap().joints).collect()
+    };
+    assert_eq!(kinds(&default_config()), [RigidJoints::Multibody; 2]);
+    for (to, joints) in [("", RigidJoints::Multibody), ("joints: Impulse,", RigidJoints::Impulse)] {
+        let root = assets_with(
+            &format!("joints_{joints:?}"),
+            "creatures/hopper.ron",
+            &edited("creatures/hopper.ron", "joints: Multibody,", to),
+        );
+        let config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
+        assert_eq!(kinds(&config)[config.kind_index("hopper").unwrap()], joints);
+    }
+    let err = load_error(
+        "joints_unknown",
+        "creatures/hopper.ron",
+        &edited("creatures/hopper.ron", "joints: Multibody,", "joints: Springs,"),
+    );
+    assert_names(&err, "creatures/hopper.ron", "rigid.joints", "`multibody` or `impulse`");
 }
 
 #[test]

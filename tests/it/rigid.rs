@@ -5,6 +5,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::support::*;
+use simlod::config::{RigidJoints, SimConfig};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use simlod::experiments::{lone_creature, stand};
 use simlod::headless::HeadlessSim;
@@ -19,13 +20,12 @@ pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
 /// One rigid creature of `kind` steered from outside at `desired`, facing it, far from the
 /// walls and the parked puck.
 pub fn lone(kind: &str, desired: Vec2) -> (HeadlessSim, Entity) {
-    let (mut sim, hopper) = lone_creature(
-        &default_config(),
-        kind,
-        LevelPolicy::AllRigid,
-        Vec2::new(-180.0, 100.0),
-        420.0,
-    );
+    lone_in(&default_config(), kind, desired)
+}
+
+/// As [`lone`], in the world of `config`.
+fn lone_in(config: &SimConfig, kind: &str, desired: Vec2) -> (HeadlessSim, Entity) {
+    let (mut sim, hopper) = lone_creature(config, kind, LevelPolicy::AllRigid, Vec2::new(-180.0, 100.0), 420.0);
     let world = sim.app.world_mut();
     world.entity_mut(hopper).insert(DesiredVelocity(desired));
     let at = world.get::<PlanarState>(hopper).unwrap().position;
@@ -111,8 +111,12 @@ fn the_biped_tracks_commanded_speeds_of_zero_to_two_and_a_half_metres_a_second()
 }
 
 fn tracks_speeds(kind: &str, speeds: &[f32]) {
+    tracks_speeds_in(&default_config(), kind, speeds);
+}
+
+fn tracks_speeds_in(config: &SimConfig, kind: &str, speeds: &[f32]) {
     for &speed in speeds {
-        let (mut sim, hopper) = lone(kind, Vec2::new(speed, 0.0));
+        let (mut sim, hopper) = lone_in(config, kind, Vec2::new(speed, 0.0));
         // Settled after 8 s; averaged over the whole hops between touchdowns up to 20 s.
         let hops = touchdowns(&mut sim, hopper, 8.0, 20.0);
         let ((t0, p0), (t1, p1)) = (hops[0], *hops.last().unwrap());
@@ -123,6 +127,32 @@ fn tracks_speeds(kind: &str, speeds: &[f32]) {
             hops.len() - 1
         );
     }
+}
+
+#[test]
+fn on_impulse_joints_the_hopper_is_free_bodies_and_tracks_its_speeds_too() {
+    let mut config = default_config();
+    let hopper = config.kind_index("hopper").unwrap();
+    config.kinds[hopper].rigid.as_mut().unwrap().joints = RigidJoints::Impulse;
+    let (mut sim, creature) = lone_in(&config, "hopper", Vec2::ZERO);
+    sim.advance_frame();
+    let world = sim.app.world_mut();
+    let bodies = world.get::<RigidBodies>(creature).unwrap().clone();
+    let joined: Vec<(bool, bool)> = bodies
+        .parts()
+        .map(|p| {
+            (
+                world.get::<ImpulseJoint>(p).is_some(),
+                world.get::<MultibodyJoint>(p).is_some(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        joined,
+        [(false, false), (true, false), (true, false)],
+        "body, upper leg, lower leg"
+    );
+    tracks_speeds_in(&config, "hopper", &[0.0, 1.0, 2.0, 3.0]);
 }
 
 #[test]

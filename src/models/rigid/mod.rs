@@ -18,7 +18,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::arena::{Ground, Puck, Wall};
-use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
+use crate::config::{LegConfig, MAX_LEGS, RigidConfig, RigidJoints};
 use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::{GaitPose, LegPose};
 use crate::lod::AtRigid;
@@ -80,12 +80,12 @@ fn leg_length_range_m(leg: &LegConfig, r: &RigidConfig) -> (f32, f32) {
 const LEG_STOP_BEYOND_THRUST_M: f32 = 0.02;
 
 /// The physics components every part shares.
-fn part(creature: Entity, transform: Transform) -> impl Bundle {
+fn part(creature: Entity, transform: Transform, velocity: Vec3) -> impl Bundle {
     (
         RigidPart { creature },
         RigidBody::Dynamic,
         transform,
-        Velocity::zero(),
+        Velocity::linear(velocity),
         ExternalForce::default(),
         Sleeping::disabled(),
         ActiveEvents::COLLISION_EVENTS,
@@ -105,8 +105,26 @@ pub struct RigidStart {
     pub velocity: Vec3,
 }
 
+/// Spawns a part joined to `parent` as the kind's rigid section says: on one multibody tree,
+/// or by an impulse joint. The joint comes in the part's one bundle, as the multibody always
+/// did: the multibody's rounding depends on how components arrive (a creature's inserts split
+/// in two changed the shipped gait tables).
+fn spawn_joined(
+    commands: &mut Commands,
+    joints: RigidJoints,
+    part: impl Bundle,
+    parent: Entity,
+    joint: TypedJoint,
+) -> Entity {
+    match joints {
+        RigidJoints::Multibody => commands.spawn((part, MultibodyJoint::new(parent, joint))).id(),
+        RigidJoints::Impulse => commands.spawn((part, ImpulseJoint::new(parent, joint))).id(),
+    }
+}
+
 /// Builds the bodies of a creature at the rigid level in `pose`, facing its heading at its
-/// planar position, the body's centre at the pose's body height.
+/// planar position, the body's centre at the pose's body height. Free bodies (impulse joints)
+/// start at `velocity`; a multibody starts at rest and is set moving by [`RigidStart`].
 pub fn spawn_bodies(
     commands: &mut Commands,
     creature: Entity,
@@ -114,7 +132,12 @@ pub fn spawn_bodies(
     r: &RigidConfig,
     state: &PlanarState,
     pose: &GaitPose,
+    velocity: Vec3,
 ) -> RigidBodies {
+    let velocity = match r.joints {
+        RigidJoints::Multibody => Vec3::ZERO,
+        RigidJoints::Impulse => velocity,
+    };
     let body_rotation = pose.body_rotation(state.heading);
     let centre = Vec3::new(state.position.x, pose.body_height_m, state.position.y);
     let (hx, hy, hz) = r.body_half_extents_m;
@@ -124,6 +147,7 @@ pub fn spawn_bodies(
             part(
                 creature,
                 Transform::from_translation(centre).with_rotation(body_rotation),
+                velocity,
             ),
             Collider::cuboid(hx, hy, hz),
             ColliderMassProperties::Mass(kind.mass_kg),
@@ -144,24 +168,37 @@ pub fn spawn_bodies(
                 .build();
             hip_joint.set_contacts_enabled(false);
             let upper_len = leg.upper_length_m;
-            let upper = commands
-                .spawn((
+            let upper = spawn_joined(
+                commands,
+                r.joints,
+                (
                     Name::new("creature upper leg"),
-                    part(creature, Transform::from_translation(hip).with_rotation(leg_rotation)),
+                    part(
+                        creature,
+                        Transform::from_translation(hip).with_rotation(leg_rotation),
+                        velocity,
+                    ),
                     Collider::compound(vec![(
                         Vec3::new(0.0, -upper_len / 2.0, 0.0),
                         Quat::IDENTITY,
                         Collider::capsule_y(upper_len / 2.0 - leg.radius_m, leg.radius_m),
                     )]),
                     ColliderMassProperties::Mass(leg.upper_mass_kg),
-                    MultibodyJoint::new(body, hip_joint.into()),
-                ))
-                .id();
+                ),
+                body,
+                hip_joint.into(),
+            );
             let shank = leg.lower_length_m - leg.foot_radius_m;
-            let lower = commands
-                .spawn((
+            let lower = spawn_joined(
+                commands,
+                r.joints,
+                (
                     Name::new("creature lower leg"),
-                    part(creature, Transform::from_translation(foot).with_rotation(leg_rotation)),
+                    part(
+                        creature,
+                        Transform::from_translation(foot).with_rotation(leg_rotation),
+                        velocity,
+                    ),
                     Collider::compound(vec![
                         (Vec3::ZERO, Quat::IDENTITY, Collider::ball(leg.foot_radius_m)),
                         (
@@ -175,9 +212,10 @@ pub fn spawn_bodies(
                         coefficient: leg.foot_friction,
                         combine_rule: CoefficientCombineRule::Max,
                     },
-                    MultibodyJoint::new(upper, leg_joint(leg, r).into()),
-                ))
-                .id();
+                ),
+                upper,
+                leg_joint(leg, r).into(),
+            );
             LegBodies { upper, lower }
         })
         .collect();
@@ -275,8 +313,13 @@ fn enter_rigid(
     let mut controller = Raibert::resuming(kind, r, state.velocity, gait, clock.seconds() as f32);
     let (pose, start) = entry_pose(kind, r, state, gait, last, &controller.entry_lengths_m);
     controller.entered_in(&pose);
-    let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose);
-    commands.entity(entity).insert((bodies, controller, start, pose));
+    let bodies = spawn_bodies(&mut commands, entity, kind, r, state, &pose, start.velocity);
+    // Free bodies start moving as spawned; a multibody is set moving by `start_multibodies`.
+    let mut creature = commands.entity(entity);
+    match r.joints {
+        RigidJoints::Multibody => creature.insert((bodies, controller, start, pose)),
+        RigidJoints::Impulse => creature.insert((bodies, controller, pose)),
+    };
 }
 
 /// Leaving the rigid level, or the world: the bodies and the controller go.
