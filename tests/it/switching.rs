@@ -11,7 +11,7 @@ use simlod::creature::{Creature, PlanarState};
 use simlod::gait::GaitPose;
 use simlod::headless::HeadlessSim;
 use simlod::lod::{Drawn, LevelPolicy, LevelSwitched, Lod, SimCamera};
-use simlod::models::rigid::RigidPart;
+use simlod::models::rigid::{RigidBodies, RigidPart};
 use simlod::outcome::CollisionRecord;
 use simlod::{SimClock, SimStage};
 
@@ -357,6 +357,23 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
             );
         }
         let rigid = creatures.iter().filter(|c| c.0 == Lod::Rigid).count();
+        // A creature that went rigid in the frame's last tick has its bodies spawned, but
+        // rapier takes them in at its next step: counted apart, as a whole creature's parts.
+        let new_bodies = world
+            .query_filtered::<(), (With<RigidBody>, Without<RapierRigidBodyHandle>)>()
+            .iter(world)
+            .count();
+        let new_colliders = world
+            .query_filtered::<(), (With<Collider>, Without<RapierColliderHandle>)>()
+            .iter(world)
+            .count();
+        let new_creatures: Vec<(usize, Entity)> = world
+            .query::<(&Creature, &RigidBodies)>()
+            .iter(world)
+            .filter(|(_, b)| world.get::<RapierRigidBodyHandle>(b.body).is_none())
+            .map(|(c, b)| (c.kind, b.body))
+            .collect();
+        let new_parts: usize = new_creatures.iter().map(|&(k, _)| 1 + 2 * legs[k]).sum();
         // A body and two parts a leg.
         let rigid_parts: usize = creatures
             .iter()
@@ -384,13 +401,31 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
             sim.clock().seconds()
         );
         assert_eq!(bodies, parts + 6, "plus ground, four walls and the puck");
-        assert_eq!(rapier_bodies, bodies, "rapier holds exactly the bodies the world has");
-        assert_eq!(rapier_colliders, colliders, "and exactly its colliders");
-        assert_eq!(multibodies, rigid, "one multibody per rigid creature");
+        assert_eq!(new_bodies, new_parts, "only creatures new this tick wait for rapier");
+        assert_eq!(
+            rapier_bodies + new_bodies,
+            bodies,
+            "rapier holds exactly the bodies the world has"
+        );
+        assert_eq!(rapier_colliders + new_colliders, colliders, "and exactly its colliders");
+        assert_eq!(
+            multibodies + new_creatures.len(),
+            rigid,
+            "one multibody per rigid creature"
+        );
         assert_eq!(impulse_joints, 0);
         // Every other entity (creatures, court, rapier's context, the app's own) is fixed.
         let others = entities - rigid_parts;
         assert_eq!(*baseline.get_or_insert(others), others, "entities besides the bodies");
+        // And the new ones are in rapier a frame later.
+        sim.advance_frame();
+        let world = sim.app.world();
+        for (_, body) in new_creatures {
+            assert!(
+                world.get_entity(body).is_err() || world.get::<RapierRigidBodyHandle>(body).is_some(),
+                "a rigid creature's body never reached rapier"
+            );
+        }
     }
     let summary = sim.summary(0.0);
     eprintln!("soak: {:?} switches, {} falls", summary.switches, summary.falls);
