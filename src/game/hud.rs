@@ -237,7 +237,7 @@ fn stats_text(
             s,
             "\nframe budget {:.1} ms per 1/30 s: predicted {:.2} ms, measured {:.2} ms{}{}",
             rules.budget.frame_budget_ms,
-            budget.predicted_us / 1e3,
+            budget.predicted_us() / 1e3,
             timing.sim_ms_per_decision,
             if rules.budget.adaptive_frames > 0.0 {
                 format!("   adaptive: model x {:.2}", budget.correction)

@@ -168,10 +168,7 @@ pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32) 
 /// What the budget policy predicted, decision by decision (the summary and the HUD read it).
 #[derive(Resource, Clone, Debug)]
 pub struct BudgetTally {
-    /// The last decision's predicted simulation time of a frame (the cost model's, times the
-    /// adaptive correction).
-    pub predicted_us: f32,
-    /// The same by the cost model alone.
+    /// The last decision's predicted simulation time of a frame by the cost model alone.
     pub model_us: f32,
     /// The adaptive mode's measured over predicted time, smoothed; 1 when it is off.
     pub correction: f32,
@@ -207,7 +204,6 @@ pub struct BudgetSummary {
 impl Default for BudgetTally {
     fn default() -> Self {
         Self {
-            predicted_us: 0.0,
             model_us: 0.0,
             correction: 1.0,
             measured_us: None,
@@ -220,6 +216,12 @@ impl Default for BudgetTally {
 }
 
 impl BudgetTally {
+    /// The last decision's predicted simulation time of a frame: the cost model's, times the
+    /// adaptive correction.
+    pub fn predicted_us(&self) -> f32 {
+        self.model_us * self.correction
+    }
+
     pub fn summary(&self, rules: &BudgetRules) -> BudgetSummary {
         BudgetSummary {
             frame_budget_ms: rules.frame_budget_ms,
@@ -234,11 +236,10 @@ impl BudgetTally {
 
     fn record(&mut self, a: &Allocation) {
         self.model_us = a.predicted_us;
-        self.predicted_us = a.predicted_us * self.correction;
         self.decisions += 1;
         self.over_budget += u64::from(a.exceeded);
-        self.predicted_sum_us += f64::from(self.predicted_us);
-        self.predicted_max_us = self.predicted_max_us.max(self.predicted_us);
+        self.predicted_sum_us += f64::from(self.predicted_us());
+        self.predicted_max_us = self.predicted_max_us.max(self.predicted_us());
     }
 }
 

@@ -50,9 +50,9 @@ fn the_predicted_cost_never_exceeds_the_budget() {
         sim.advance_frame();
         let tally = sim.app.world().resource::<BudgetTally>().clone();
         assert!(
-            tally.predicted_us <= budget_ms * 1e3,
+            tally.predicted_us() <= budget_ms * 1e3,
             "predicted {} us at {} s",
-            tally.predicted_us,
+            tally.predicted_us(),
             sim.clock().seconds()
         );
         assert_eq!(tally.over_budget, 0);
@@ -172,7 +172,7 @@ fn the_adaptive_mode_spends_less_where_frames_measure_dearer_than_the_cost_model
     assert!((tally.correction - 3.0).abs() < 0.05, "{tally:?}");
     // The model's prediction now fits a third of the budget; the corrected one the budget.
     assert!(tally.model_us <= budget_ms * 1e3 / 3.0 + 1e-3, "{tally:?}");
-    assert!(tally.predicted_us <= budget_ms * 1e3 + 1e-3, "{tally:?}");
+    assert!(tally.predicted_us() <= budget_ms * 1e3 + 1e-3, "{tally:?}");
     let summary = sim.summary(0.0);
     let budget = summary.budget.expect("a budget summary");
     assert!(budget.adaptive && (budget.correction - 3.0).abs() < 0.05, "{budget:?}");
