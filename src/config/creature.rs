@@ -113,7 +113,7 @@ pub struct RigidConfig {
     /// `*_kd_*` 0 to 1e4, torques 0 to 1e4 N m, speeds 0 to 50 m/s, as each field says.
     pub controller: RaibertConfig,
     pub fall: FallConfig,
-    /// How rapier joins the bodies: `Multibody` (the default) or `Impulse`.
+    /// How rapier joins the bodies: `Impulse` (the default) or `Multibody`.
     #[serde(default)]
     pub joints: RigidJoints,
 }
@@ -123,10 +123,11 @@ pub struct RigidConfig {
 pub enum RigidJoints {
     /// One multibody (reduced-coordinate) joint tree per creature: the joints hold exactly,
     /// but rapier rebuilds the tree's mass matrix at each solver iteration.
-    #[default]
     Multibody,
-    /// Free bodies held together by impulse joints, solved with the contacts: cheaper, and
-    /// the joints give a little under load.
+    /// Free bodies held together by impulse joints, solved with the contacts: a fraction of
+    /// the multibody's cost; the joints give a little under load, so they want more solver
+    /// iterations (the scenario's `solver_iterations`).
+    #[default]
     Impulse,
 }
 

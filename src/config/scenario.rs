@@ -17,9 +17,10 @@ pub struct Scenario {
     /// Steering decisions per second, any that divides `tick_hz` (1 Hz up); the paper's frame
     /// rate is 30.
     pub decision_hz: u32,
-    /// Rapier's solver iterations per tick, 1 to 16 (each is a substep of the tick; 4 when
-    /// left out, rapier's default). Most of a rigid creature's cost is its multibody's mass
-    /// matrix, rebuilt once per iteration: see the README's "The rigid level's cost".
+    /// Rapier's solver iterations per tick, 1 to 16 (each is a substep of the tick; 8 when
+    /// left out). Impulse joints hold the hopper's gait steady at its top speed from 8 (at
+    /// rapier's default of 4 its hops vary by 10 %); a multibody's cost grows with them: see
+    /// the README's "The rigid level's cost".
     #[serde(default = "default_solver_iterations")]
     pub solver_iterations: u32,
     /// The arena file, relative to the assets folder and inside it.
@@ -53,7 +54,7 @@ impl Scenario {
 }
 
 fn default_solver_iterations() -> u32 {
-    4
+    8
 }
 
 /// Most creatures a scenario may hold.

@@ -128,6 +128,8 @@ fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &Record
     // The stance share of each step, known at the touchdown that ends it.
     let mut stance_shares: Vec<(f32, f32)> = Vec::new();
     let (_, mut last) = sample(&mut sim, creature)?;
+    // The steadiest run of strides seen, for the error if none is steady enough.
+    let mut steadiest = (f32::INFINITY, f32::INFINITY);
     let strides = loop {
         sim.advance_frame();
         let (tick, gait) = sample(&mut sim, creature)?;
@@ -149,15 +151,26 @@ fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &Record
             let recent = &stride_starts[stride_starts.len() - s.hops - 1..];
             let strides: Vec<(f32, f32)> = recent.windows(2).map(|w| (w[0], w[1])).collect();
             let (period_share, speed_spread) = unsteadiness(&strides, &ticks);
+            // Each spread as a share of its limit: steady when neither passes 1.
+            let excess = |(p, v): (f32, f32)| (p / s.steady_period_share).max(v / s.steady_speed_m_per_s);
+            if excess((period_share, speed_spread)) < excess(steadiest) {
+                steadiest = (period_share, speed_spread);
+            }
             if period_share <= s.steady_period_share && speed_spread <= s.steady_speed_m_per_s {
                 break strides;
             }
         }
         if sim.clock().seconds() > f64::from(s.settle_s + s.steady_within_s) {
             return Err(format!(
-                "no steady gait at {speed} m/s within {} s: {} strides",
+                "no steady gait at {speed} m/s within {} s: {} strides; the steadiest {} had periods \
+                 {:.1} % apart (at most {:.1} %) and speeds {:.3} m/s apart (at most {})",
                 s.steady_within_s,
-                stride_starts.len()
+                stride_starts.len(),
+                s.hops,
+                steadiest.0 * 100.0,
+                s.steady_period_share * 100.0,
+                steadiest.1,
+                s.steady_speed_m_per_s
             ));
         }
     };

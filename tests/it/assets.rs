@@ -79,16 +79,19 @@ fn a_value_of_the_wrong_type_is_named_by_its_whole_path() {
 }
 
 #[test]
-fn the_rigid_joints_are_a_multibody_unless_the_file_says_impulse_and_others_are_named() {
+fn the_rigid_joints_are_impulse_joints_unless_the_file_says_multibody_and_others_are_named() {
     let kinds = |config: &SimConfig| -> Vec<RigidJoints> {
         config.kinds.iter().map(|k| k.rigid.as_ref().unwrap().joints).collect()
     };
-    assert_eq!(kinds(&default_config()), [RigidJoints::Multibody; 2]);
-    for (to, joints) in [("", RigidJoints::Multibody), ("joints: Impulse,", RigidJoints::Impulse)] {
+    assert_eq!(kinds(&default_config()), [RigidJoints::Impulse; 2]);
+    for (to, joints) in [
+        ("", RigidJoints::Impulse),
+        ("joints: Multibody,", RigidJoints::Multibody),
+    ] {
         let root = assets_with(
             &format!("joints_{joints:?}"),
             "creatures/hopper.ron",
-            &edited("creatures/hopper.ron", "joints: Multibody,", to),
+            &edited("creatures/hopper.ron", "joints: Impulse,", to),
         );
         let config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
         assert_eq!(kinds(&config)[config.kind_index("hopper").unwrap()], joints);
@@ -96,7 +99,7 @@ fn the_rigid_joints_are_a_multibody_unless_the_file_says_impulse_and_others_are_
     let err = load_error(
         "joints_unknown",
         "creatures/hopper.ron",
-        &edited("creatures/hopper.ron", "joints: Multibody,", "joints: Springs,"),
+        &edited("creatures/hopper.ron", "joints: Impulse,", "joints: Springs,"),
     );
     assert_names(&err, "creatures/hopper.ron", "rigid.joints", "`multibody` or `impulse`");
 }
@@ -117,8 +120,8 @@ fn a_negative_mass_is_refused() {
 }
 
 #[test]
-fn solver_iterations_default_to_rapiers_and_out_of_range_are_refused() {
-    assert_eq!(default_config().scenario.solver_iterations, 4);
+fn solver_iterations_default_to_eight_and_out_of_range_are_refused() {
+    assert_eq!(default_config().scenario.solver_iterations, 8);
     let err = load_error(
         "solver_iterations",
         "scenarios/default.ron",
@@ -576,15 +579,20 @@ fn more_creatures_than_the_court_can_hold_are_refused_at_once_with_the_numbers()
 }
 
 #[test]
-fn the_scenarios_solver_iterations_reach_rapier() {
+fn the_scenarios_solver_iterations_reach_rapier_which_recycles_no_contacts() {
     let mut config = config_with_hoppers(1);
     config.scenario.solver_iterations = 2;
     let mut sim = simlod::headless::HeadlessSim::new(config);
     let world = sim.app.world_mut();
-    let iterations: Vec<usize> = world
+    let parameters: Vec<(usize, bool)> = world
         .query::<&bevy_rapier3d::prelude::RapierContextSimulation>()
         .iter(world)
-        .map(|s| s.integration_parameters.num_solver_iterations)
+        .map(|s| {
+            (
+                s.integration_parameters.num_solver_iterations,
+                s.integration_parameters.contact_recycling,
+            )
+        })
         .collect();
-    assert_eq!(iterations, [2]);
+    assert_eq!(parameters, [(2, false)]);
 }

@@ -130,10 +130,10 @@ fn tracks_speeds_in(config: &SimConfig, kind: &str, speeds: &[f32]) {
 }
 
 #[test]
-fn on_impulse_joints_the_hopper_is_free_bodies_and_tracks_its_speeds_too() {
+fn on_a_multibody_the_hopper_is_one_joint_tree_and_tracks_its_speeds_too() {
     let mut config = default_config();
     let hopper = config.kind_index("hopper").unwrap();
-    config.kinds[hopper].rigid.as_mut().unwrap().joints = RigidJoints::Impulse;
+    config.kinds[hopper].rigid.as_mut().unwrap().joints = RigidJoints::Multibody;
     let (mut sim, creature) = lone_in(&config, "hopper", Vec2::ZERO);
     sim.advance_frame();
     let world = sim.app.world_mut();
@@ -149,7 +149,7 @@ fn on_impulse_joints_the_hopper_is_free_bodies_and_tracks_its_speeds_too() {
         .collect();
     assert_eq!(
         joined,
-        [(false, false), (true, false), (true, false)],
+        [(false, false), (false, true), (false, true)],
         "body, upper leg, lower leg"
     );
     tracks_speeds_in(&config, "hopper", &[0.0, 1.0, 2.0, 3.0]);
