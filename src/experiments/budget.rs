@@ -167,8 +167,55 @@ struct Point {
     /// The mean of each trial's difference, without its sign: how far a trial's outcome moves.
     mean_abs_difference: f64,
     sd_difference: f64,
+    /// The standard error of the mean difference.
+    se_difference: f64,
     mean_rigid: f64,
     speedup: f64,
+}
+
+/// A budget's point against the fixed-radius curve at the same speed-up.
+#[derive(Clone, Debug, Serialize)]
+struct Against {
+    budget_ms: f32,
+    speedup: f64,
+    difference: f64,
+    se_difference: f64,
+    /// The fixed-radius curve's mean difference and standard error at this speed-up,
+    /// interpolated in log speed-up between the radii on either side.
+    fixed_difference: f64,
+    fixed_se_difference: f64,
+    /// The budget's outcome is nearer all rigid's than the fixed radii's by more than two
+    /// standard errors of the gap.
+    nearer_beyond_2_se: bool,
+}
+
+/// Each budget point that lies within the fixed-radius curve's range of speed-ups, against
+/// that curve at its speed-up (figure 10's axes: the nearer zero the difference, the better).
+fn against_fixed(fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
+    let mut curve: Vec<&Point> = fixed.to_vec();
+    curve.sort_by(|a, b| a.speedup.total_cmp(&b.speedup));
+    budget
+        .iter()
+        .filter_map(|b| {
+            let i = curve
+                .windows(2)
+                .position(|w| w[0].speedup <= b.speedup && b.speedup <= w[1].speedup)?;
+            let (lo, hi) = (curve[i], curve[i + 1]);
+            let w = (b.speedup / lo.speedup).ln() / (hi.speedup / lo.speedup).ln().max(1e-12);
+            let at = |f: fn(&Point) -> f64| f(lo) + w * (f(hi) - f(lo));
+            let (fixed_difference, fixed_se_difference) = (at(|p| p.mean_difference), at(|p| p.se_difference));
+            let gap = fixed_difference.abs() - b.mean_difference.abs();
+            Some(Against {
+                budget_ms: b.setting,
+                speedup: b.speedup,
+                difference: b.mean_difference,
+                se_difference: b.se_difference,
+                fixed_difference,
+                fixed_se_difference,
+                nearer_beyond_2_se: gap > 2.0 * b.se_difference.hypot(fixed_se_difference),
+            })
+        })
+        .collect()
 }
 
 fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
@@ -194,6 +241,7 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
                 mean_difference,
                 mean_abs_difference: mean(&|r| r.difference().abs()),
                 sd_difference: var.sqrt(),
+                se_difference: (var / n).sqrt(),
                 mean_rigid: mean(&|r| r.mean_rigid),
                 speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
             }
@@ -314,6 +362,7 @@ fn finish(
     }
     let curve = |policy: &str| -> Vec<&Point> { points.iter().filter(|p| p.policy == policy).collect() };
     let (fixed, budget) = (curve("influence"), curve("budget"));
+    let against = against_fixed(&fixed, &budget);
     let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, p.speedup)).collect::<Vec<_>>();
     let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
         ps.iter()
@@ -373,15 +422,41 @@ fn finish(
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
          The difference is the policy's creatures that collided with the puck or a wall minus all rigid's; \
          the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`).\n\n\
-         | policy | setting | difference: mean | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up |\n|---|---|---|---|---|---|---|\n",
+         | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up |\n|---|---|---|---|---|---|---|\n",
         s.trials, s.seconds, s.first_seed, s.fixed_rules, s.budget_rules
     );
     for p in points {
         let unit = if p.policy == "budget" { "ms" } else { "m" };
         let _ = writeln!(
             report,
-            "| {} | {} {unit} | {:+.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
-            p.policy, p.setting, p.mean_difference, p.mean_abs_difference, p.sd_difference, p.mean_rigid, p.speedup
+            "| {} | {} {unit} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
+            p.policy,
+            p.setting,
+            p.mean_difference,
+            p.se_difference,
+            p.mean_abs_difference,
+            p.sd_difference,
+            p.mean_rigid,
+            p.speedup
+        );
+    }
+    let _ = write!(
+        report,
+        "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; budgets outside \
+         its range of speed-ups are left out). Nearer zero is nearer all rigid's outcome.\n\n\
+         | budget | speed-up | difference +- s.e. | fixed radii at that speed-up | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|\n"
+    );
+    for a in &against {
+        let _ = writeln!(
+            report,
+            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
+            a.budget_ms,
+            a.speedup,
+            a.difference,
+            a.se_difference,
+            a.fixed_difference,
+            a.fixed_se_difference,
+            if a.nearer_beyond_2_se { "yes" } else { "no" }
         );
     }
     let _ = write!(
@@ -401,8 +476,47 @@ fn finish(
     ExperimentRecord {
         experiment: "budget".into(),
         command: command("budget", options),
-        summary: serde_json::json!({ "points": points, "crowd": crowd }),
+        summary: serde_json::json!({ "points": points, "against_fixed": against, "crowd": crowd }),
         report,
     }
     .finish(out, &csv)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(policy: &'static str, setting: f32, speedup: f64, mean_difference: f64, se_difference: f64) -> Point {
+        Point {
+            policy,
+            setting,
+            trials: 10,
+            mean_difference,
+            mean_abs_difference: mean_difference.abs(),
+            sd_difference: se_difference * 10f64.sqrt(),
+            se_difference,
+            mean_rigid: 0.0,
+            speedup,
+        }
+    }
+
+    #[test]
+    fn a_budget_is_weighed_against_the_fixed_radii_interpolated_at_its_speedup() {
+        let fixed = [
+            point("influence", 8.0, 2.0, -1.0, 0.1),
+            point("influence", 0.0, 8.0, -0.2, 0.1),
+        ];
+        let budget = [
+            point("budget", 1.0, 4.0, 0.0, 0.05),
+            point("budget", 2.0, 4.0, -0.7, 0.05),
+            point("budget", 0.5, 16.0, 0.0, 0.05),
+        ];
+        let against = against_fixed(&fixed.iter().collect::<Vec<_>>(), &budget.iter().collect::<Vec<_>>());
+        // 4 is halfway from 2 to 8 in log speed-up; 16 is past the curve's end.
+        assert_eq!(against.len(), 2);
+        assert!((against[0].fixed_difference + 0.6).abs() < 1e-9, "{against:?}");
+        assert!((against[0].fixed_se_difference - 0.1).abs() < 1e-9);
+        assert!(against[0].nearer_beyond_2_se, "0.6 nearer, 2 s.e. is 0.22");
+        assert!(!against[1].nearer_beyond_2_se, "farther than the curve");
+    }
 }
