@@ -23,8 +23,9 @@ fn game(blended: bool) -> SimConfig {
 
 #[test]
 fn over_whole_games_every_switch_is_drawn_under_the_bars() {
-    // The paper's rules, the camera rule (its point masses out of view), and areas of
-    // influence shrunk to nothing, so that creatures go rigid only when a collision forces it.
+    // The paper's rules, the camera rule (its point masses out of view), areas of influence
+    // shrunk to nothing, so that creatures go rigid only when a collision forces it, and the
+    // frame budget (which moves creatures between levels as contacts near).
     let mut camera = game(true);
     camera.scenario.level_policy = LevelPolicy::Camera;
     let mut collisions_only = game(true);
@@ -35,9 +36,11 @@ fn over_whole_games_every_switch_is_drawn_under_the_bars() {
         influence.creature_radius_m,
         influence.wall_band_m,
     ) = (0.0, 0.0, 0.0);
+    let mut budget = game(true);
+    budget.scenario.level_policy = LevelPolicy::Budget;
     let mut pops = Vec::new();
     let (mut switches, mut falls) = (0, 0);
-    for config in [game(true), camera, collisions_only] {
+    for config in [game(true), camera, collisions_only, budget] {
         let (_, summary) = digest_after(config, 20.0);
         switches += summary.switches.total();
         falls += summary.falls;
