@@ -10,7 +10,7 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::{AtPointMass, AtRigid, Lod};
-use crate::{SimClock, SimStage};
+use crate::{SimClock, SimStage, chunk_len, run_chunks};
 
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
@@ -99,35 +99,43 @@ fn step_point_masses(
 ) {
     let (dt, now) = (clock.dt, clock.seconds() as f32);
     let turns: Vec<TurnLimit> = kinds.0.iter().map(|k| TurnLimit::new(k, dt)).collect();
-    for_each_creature!(config.scenario.creature_count(), creatures, |(
-        creature,
-        lod,
-        desired,
-        mut state,
-        mut gait,
-        mut pose,
-    ): (
-        &Creature,
-        &Lod,
-        &DesiredVelocity,
-        Mut<PlanarState>,
-        Mut<GaitPhase>,
-        Mut<GaitPose>
-    )| {
+    let step = |creature: &Creature,
+                lod: Lod,
+                desired: &DesiredVelocity,
+                state: &mut PlanarState,
+                gait: &mut GaitPhase,
+                pose: &mut GaitPose| {
         let kind = &kinds[creature.kind];
         match (lod, &kind.gait) {
             (Lod::PointMass, _) => {
-                step_planar(&mut state, desired.0, kind, &turns[creature.kind], dt);
-                advance_gait(&mut gait, kind, now, dt);
+                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
+                advance_gait(gait, kind, now, dt);
             }
             (Lod::Hybrid, Some(table)) => {
-                step_planar(&mut state, desired.0, kind, &turns[creature.kind], dt);
-                hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), now, dt);
+                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
+                hybrid::play_gait(gait, pose, table, state.velocity.length(), now, dt);
             }
             // A hybrid whose kind has no table is not made: `KindParams::best_level`.
             _ => {}
         }
-    });
+    };
+    // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
+    // of each creature's components one by one cost more than the step itself.
+    let tables = creatures
+        .contiguous_iter_mut()
+        .expect("table components and an archetype filter: dense");
+    for (creature, lod, desired, mut state, mut gait, mut pose) in tables {
+        let n = chunk_len(config.scenario.creature_count(), creature.len());
+        let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
+            .zip(state.chunks_mut(n).zip(gait.chunks_mut(n)).zip(pose.chunks_mut(n)));
+        run_chunks(chunks.map(|(((c, l), d), ((s, g), p))| {
+            move || {
+                for (((c, l), d), ((s, g), p)) in (c.iter().zip(l).zip(d)).zip(s.iter_mut().zip(g).zip(p)) {
+                    step(c, *l, d, s, g, p);
+                }
+            }
+        }));
+    }
 }
 
 pub(super) fn plugin(app: &mut App) {
