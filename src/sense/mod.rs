@@ -72,8 +72,11 @@ impl NeighbourGrid {
                 self.cell_start[c as usize + 2] += 1;
             }
         }
-        for c in 1..self.cell_start.len() {
-            self.cell_start[c] += self.cell_start[c - 1];
+        // The running sum in a register: each cell waits on an add, not on the store before it.
+        let mut sum = 0;
+        for start in &mut self.cell_start {
+            sum += *start;
+            *start = sum;
         }
         // Scatter in input order within each cell: deterministic.
         self.entries.clear();
