@@ -33,6 +33,9 @@ macro_rules! for_each_creature {
 /// Below this many creatures a loop over them stays on one thread.
 pub const PARALLEL_MIN_CREATURES: u32 = 2048;
 
+/// Why a loop's query can be iterated column by column (Bevy's contiguous iteration).
+pub(crate) const DENSE: &str = "table components and archetype filters only: a dense query";
+
 /// How many of `len` items (a table's column) each thread takes in a loop over creatures: all
 /// of them below [`PARALLEL_MIN_CREATURES`].
 pub fn chunk_len(population: u32, len: usize) -> usize {

@@ -10,7 +10,7 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::{AtPointMass, AtRigid, Lod};
-use crate::{SimClock, SimStage, chunk_len, run_chunks};
+use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
 
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
@@ -121,10 +121,7 @@ fn step_point_masses(
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
     // of each creature's components one by one cost more than the step itself.
-    let tables = creatures
-        .contiguous_iter_mut()
-        .expect("table components and an archetype filter: dense");
-    for (creature, lod, desired, mut state, mut gait, mut pose) in tables {
+    for (creature, lod, desired, mut state, mut gait, mut pose) in creatures.contiguous_iter_mut().expect(DENSE) {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
             .zip(state.chunks_mut(n).zip(gait.chunks_mut(n)).zip(pose.chunks_mut(n)));
