@@ -135,10 +135,13 @@ impl NeighbourGrid {
                 self.block_start[(blocks + x0 / BLOCK_CELLS) as usize] as usize,
                 self.block_start[(blocks + x1 / BLOCK_CELLS + 1) as usize] as usize,
             );
-            // The blocks' entries in cells x0..=x1 of this row, in the order of their cells.
-            let cells = y * self.cols + x0..=y * self.cols + x1;
-            for (n, c) in self.entries[a..b].iter().zip(&self.entry_cell[a..b]) {
-                if cells.contains(c) && n.position.distance_squared(p) <= r2 {
+            // The blocks' entries in cells x0..=x1 of this row (they are in the order of their cells).
+            let (first, last) = (y * self.cols + x0, y * self.cols + x1);
+            for (n, &c) in self.entries[a..b].iter().zip(&self.entry_cell[a..b]) {
+                if c > last {
+                    break;
+                }
+                if c >= first && n.position.distance_squared(p) <= r2 {
                     f(n);
                 }
             }
