@@ -33,6 +33,34 @@ macro_rules! for_each_creature {
 /// Below this many creatures a loop over them stays on one thread.
 pub const PARALLEL_MIN_CREATURES: u32 = 2048;
 
+/// Why a loop's query can be iterated column by column (Bevy's contiguous iteration).
+pub(crate) const DENSE: &str = "table components and archetype filters only: a dense query";
+
+/// How many of `len` items (a table's column) each thread takes in a loop over creatures: all
+/// of them below [`PARALLEL_MIN_CREATURES`].
+pub fn chunk_len(population: u32, len: usize) -> usize {
+    let threads = if population < PARALLEL_MIN_CREATURES {
+        1
+    } else {
+        bevy::tasks::ComputeTaskPool::get().thread_num().max(1)
+    };
+    len.div_ceil(threads).max(1)
+}
+
+/// Runs one job per chunk of [`chunk_len`] across the compute pool; a lone job runs here.
+pub fn run_chunks<J: FnOnce() + Send>(jobs: impl Iterator<Item = J>) {
+    let mut jobs = jobs.peekable();
+    let Some(first) = jobs.next() else { return };
+    if jobs.peek().is_none() {
+        return first();
+    }
+    bevy::tasks::ComputeTaskPool::get().scope(|scope| {
+        for job in std::iter::once(first).chain(jobs) {
+            scope.spawn(async move { job() });
+        }
+    });
+}
+
 pub mod arena;
 pub mod bench;
 pub mod config;

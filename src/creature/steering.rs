@@ -12,7 +12,7 @@ use super::{Creature, DesiredVelocity, KindParams, KindTable, PlanarState, Playe
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage};
+use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
 
 /// A deterministic random number in `[-1, 1]` for one creature at one decision: a
 /// counter-based stream keyed by the world seed, so parallel steering stays reproducible.
@@ -126,17 +126,20 @@ fn steer(
         decision: clock.decision(),
         decision_dt: clock.dt * clock.ticks_per_decision as f32,
     };
-    for_each_creature!(config.scenario.creature_count(), creatures, |(
-        creature,
-        state,
-        mut desired,
-    ): (
-        _,
-        _,
-        Mut<DesiredVelocity>
-    )| {
+    let steer_one = |creature: &Creature, state: &PlanarState, desired: &mut DesiredVelocity| {
         desired.0 = desired_velocity(creature, state, &kinds[creature.kind], &around);
-    });
+    };
+    for (creature, state, mut desired) in creatures.contiguous_iter_mut().expect(DENSE) {
+        let n = chunk_len(config.scenario.creature_count(), creature.len());
+        let chunks = creature.chunks(n).zip(state.chunks(n)).zip(desired.chunks_mut(n));
+        run_chunks(chunks.map(|((c, s), d)| {
+            move || {
+                for ((c, s), d) in c.iter().zip(s).zip(d) {
+                    steer_one(c, s, d);
+                }
+            }
+        }));
+    }
 }
 
 pub(super) fn plugin(app: &mut App) {

@@ -10,15 +10,35 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::{AtPointMass, AtRigid, Lod};
-use crate::{SimClock, SimStage};
+use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
 
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
 
+/// The most a body of a kind turns in one tick, as its cosine and the rotations either way:
+/// the same for every creature of the kind, so worked out once a tick, not once a creature.
+#[derive(Clone, Copy, Debug)]
+pub struct TurnLimit {
+    cos: f32,
+    left: Vec2,
+    right: Vec2,
+}
+
+impl TurnLimit {
+    pub fn new(kind: &KindParams, dt: f32) -> Self {
+        let max_turn = kind.turn_rate_rad_per_s * dt;
+        Self {
+            cos: max_turn.cos(),
+            left: Vec2::from_angle(max_turn.abs()),
+            right: Vec2::from_angle(-max_turn.abs()),
+        }
+    }
+}
+
 /// One tick of the planar point mass: velocity moves toward the desired one, clipped to the
 /// top speed, by at most the acceleration limit. A body faster than its top speed (shoved,
 /// or just switched from the rigid level) slows at the limit: no pop in velocity.
-pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt: f32) {
+pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, turn: &TurnLimit, dt: f32) {
     let target = desired.clamp_length_max(kind.top_speed_m_per_s);
     state.velocity += (target - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
     state.position += state.velocity * dt;
@@ -27,11 +47,12 @@ pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, dt
         // Turn toward the direction of travel at the turn rate: no pop when the body came
         // from a level that faced elsewhere.
         let travel = state.velocity / speed;
-        let max_turn = kind.turn_rate_rad_per_s * dt;
-        state.heading = if state.heading.dot(travel) >= max_turn.cos() {
+        state.heading = if state.heading.dot(travel) >= turn.cos {
             travel
+        } else if state.heading.perp_dot(travel).is_sign_negative() {
+            turn.right.rotate(state.heading)
         } else {
-            Vec2::from_angle(max_turn.copysign(state.heading.perp_dot(travel))).rotate(state.heading)
+            turn.left.rotate(state.heading)
         };
     }
 }
@@ -77,35 +98,41 @@ fn step_point_masses(
     >,
 ) {
     let (dt, now) = (clock.dt, clock.seconds() as f32);
-    for_each_creature!(config.scenario.creature_count(), creatures, |(
-        creature,
-        lod,
-        desired,
-        mut state,
-        mut gait,
-        mut pose,
-    ): (
-        &Creature,
-        &Lod,
-        &DesiredVelocity,
-        Mut<PlanarState>,
-        Mut<GaitPhase>,
-        Mut<GaitPose>
-    )| {
+    let turns: Vec<TurnLimit> = kinds.0.iter().map(|k| TurnLimit::new(k, dt)).collect();
+    let step = |creature: &Creature,
+                lod: Lod,
+                desired: &DesiredVelocity,
+                state: &mut PlanarState,
+                gait: &mut GaitPhase,
+                pose: &mut GaitPose| {
         let kind = &kinds[creature.kind];
         match (lod, &kind.gait) {
             (Lod::PointMass, _) => {
-                step_planar(&mut state, desired.0, kind, dt);
-                advance_gait(&mut gait, kind, now, dt);
+                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
+                advance_gait(gait, kind, now, dt);
             }
             (Lod::Hybrid, Some(table)) => {
-                step_planar(&mut state, desired.0, kind, dt);
-                hybrid::play_gait(&mut gait, &mut pose, table, state.velocity.length(), now, dt);
+                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
+                hybrid::play_gait(gait, pose, table, state.velocity.length(), now, dt);
             }
             // A hybrid whose kind has no table is not made: `KindParams::best_level`.
             _ => {}
         }
-    });
+    };
+    // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
+    // of each creature's components one by one cost more than the step itself.
+    for (creature, lod, desired, mut state, mut gait, mut pose) in creatures.contiguous_iter_mut().expect(DENSE) {
+        let n = chunk_len(config.scenario.creature_count(), creature.len());
+        let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
+            .zip(state.chunks_mut(n).zip(gait.chunks_mut(n)).zip(pose.chunks_mut(n)));
+        run_chunks(chunks.map(|(((c, l), d), ((s, g), p))| {
+            move || {
+                for (((c, l), d), ((s, g), p)) in (c.iter().zip(l).zip(d)).zip(s.iter_mut().zip(g).zip(p)) {
+                    step(c, *l, d, s, g, p);
+                }
+            }
+        }));
+    }
 }
 
 pub(super) fn plugin(app: &mut App) {
@@ -158,7 +185,7 @@ pub(crate) mod tests {
         let mut s = PlanarState::default();
         let dt = 1.0 / 240.0;
         for _ in 0..240 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
         }
         assert!(
             (s.velocity.x - 2.0).abs() < 1e-3,
@@ -166,7 +193,7 @@ pub(crate) mod tests {
             s.velocity.x
         );
         for _ in 0..480 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
         }
         assert!((s.velocity.length() - 3.0).abs() < 1e-4);
         assert_eq!(s.heading, Vec2::X);
@@ -181,7 +208,7 @@ pub(crate) mod tests {
         };
         let dt = 1.0 / 240.0;
         for _ in 0..120 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, dt);
+            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
         }
         assert!(
             (s.velocity.x - 3.0).abs() < 1e-3,
@@ -197,7 +224,7 @@ pub(crate) mod tests {
             velocity: Vec2::new(0.0, 1.0),
             ..default()
         };
-        step_planar(&mut s, Vec2::new(0.0, 1.0), &k, 0.01);
+        step_planar(&mut s, Vec2::new(0.0, 1.0), &k, &TurnLimit::new(&k, 0.01), 0.01);
         assert!((s.heading_angle() - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
     }
 

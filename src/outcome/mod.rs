@@ -30,7 +30,7 @@ use crate::lod::{
     SwitchTally,
 };
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage, SimStart, WorldRng};
+use crate::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
 
 /// What a creature can collide with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -269,24 +269,24 @@ fn detect_collisions(
     let frame_s = clock.dt * clock.ticks_per_decision as f32;
     let puck_reach_m = config.arena.puck.speed_m_per_s * frame_s;
     let chosen_now = &*chosen;
-    for_each_creature!(config.scenario.creature_count(), creatures, |(
-        entity,
-        creature,
-        mut state,
-        mut record,
-    ): (
-        Entity,
-        &Creature,
-        Mut<PlanarState>,
-        Mut<CollisionRecord>
-    )| {
-        collide(entity, creature, &mut state, &mut record, decision.then_some(&*grid));
+    let check = |entity: Entity, creature: &Creature, state: &mut PlanarState, record: &mut CollisionRecord| {
+        collide(entity, creature, state, record, decision.then_some(&*grid));
         let kind = &kinds[creature.kind];
-        if decision && could_reach_puck_or_wall(&state, &record, kind, &puck, puck_reach_m, court.half_extents, frame_s)
-        {
+        if decision && could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s) {
             chosen_now.borrow_local_mut().push(entity);
         }
-    });
+    };
+    for (entity, creature, mut state, mut record) in creatures.contiguous_iter_mut().expect(DENSE) {
+        let n = chunk_len(config.scenario.creature_count(), entity.len());
+        let chunks = (entity.chunks(n).zip(creature.chunks(n))).zip(state.chunks_mut(n).zip(record.chunks_mut(n)));
+        run_chunks(chunks.map(|((e, c), (s, r))| {
+            move || {
+                for ((e, c), (s, r)) in (e.iter().zip(c)).zip(s.iter_mut().zip(r)) {
+                    check(*e, c, s, r);
+                }
+            }
+        }));
+    }
     if decision {
         switched.clear();
         let watch = &mut *watch;

@@ -18,6 +18,11 @@ pub struct Neighbour {
     pub serial: u32,
 }
 
+/// Cells per block along a row: the index keeps where each block's entries start, not each
+/// cell's, so a rebuild clears and sums an eighth of the cells (23 cells a creature at the
+/// shipped density: the cells, not the creatures, were most of a rebuild and of the memory).
+const BLOCK_CELLS: u32 = 8;
+
 /// A uniform grid over the court, rebuilt by counting sort at every steering decision.
 #[derive(Resource, Debug, Default)]
 pub struct NeighbourGrid {
@@ -25,11 +30,16 @@ pub struct NeighbourGrid {
     inv_cell_m: f32,
     cols: u32,
     rows: u32,
-    /// `cell_start[c]..cell_start[c + 1]` are the entries of cell `c`.
-    cell_start: Vec<u32>,
+    /// Blocks of [`BLOCK_CELLS`] cells along a row, per row.
+    block_cols: u32,
+    /// `block_start[b]..block_start[b + 1]` are the entries of block `b` (row by row), in the
+    /// order of their cells, and in input order within a cell.
+    block_start: Vec<u32>,
     entries: Vec<Neighbour>,
-    /// Scratch: each entry's cell, kept to avoid an allocation per rebuild.
-    cell_of_entry: Vec<u32>,
+    /// Each entry's cell (`row * cols + column`).
+    entry_cell: Vec<u32>,
+    /// Scratch, kept to avoid an allocation per rebuild: each input's block and cell.
+    keys: Vec<(u32, u32)>,
     scratch: Vec<Neighbour>,
 }
 
@@ -38,48 +48,71 @@ impl NeighbourGrid {
     pub fn new(half: Vec2, cell_m: f32) -> Self {
         let cols = ((2.0 * half.x / cell_m).ceil() as u32).max(1);
         let rows = ((2.0 * half.y / cell_m).ceil() as u32).max(1);
+        let block_cols = cols.div_ceil(BLOCK_CELLS);
         Self {
             min: -half,
             inv_cell_m: 1.0 / cell_m,
             cols,
             rows,
-            cell_start: vec![0; (cols * rows + 1) as usize],
+            block_cols,
+            block_start: vec![0; (block_cols * rows + 1) as usize],
             ..default()
         }
     }
 
     fn cell_xy(&self, p: Vec2) -> (u32, u32) {
-        let c = ((p - self.min) * self.inv_cell_m).floor();
-        (
-            (c.x.max(0.0) as u32).min(self.cols - 1),
-            (c.y.max(0.0) as u32).min(self.rows - 1),
-        )
+        // No `floor`: clamped at 0 first, the cast's truncation is the floor (and a library call less).
+        let c = ((p - self.min) * self.inv_cell_m).max(Vec2::ZERO);
+        ((c.x as u32).min(self.cols - 1), (c.y as u32).min(self.rows - 1))
     }
 
     /// Replaces the contents with `items`.
     pub fn rebuild(&mut self, items: impl Iterator<Item = Neighbour>) {
         self.scratch.clear();
         self.scratch.extend(items);
-        self.cell_of_entry.clear();
-        self.cell_start.fill(0);
+        self.keys.clear();
+        self.block_start.fill(0);
+        // Block b's count goes to b + 2, so that after the sums `block_start[b + 1]` is where b
+        // starts; the scatter moves it on to where b ends, which is where b + 1 starts (no copy
+        // of the starts as the scatter's cursors).
+        let last = self.block_start.len() - 2;
         for n in &self.scratch {
             let (x, y) = self.cell_xy(n.position);
-            let c = y * self.cols + x;
-            self.cell_of_entry.push(c);
-            self.cell_start[c as usize + 1] += 1;
+            let b = y * self.block_cols + x / BLOCK_CELLS;
+            self.keys.push((b, y * self.cols + x));
+            if (b as usize) < last {
+                self.block_start[b as usize + 2] += 1;
+            }
         }
-        for c in 1..self.cell_start.len() {
-            self.cell_start[c] += self.cell_start[c - 1];
+        // The running sum in a register: each block waits on an add, not on the store before it.
+        let mut sum = 0;
+        for start in &mut self.block_start {
+            sum += *start;
+            *start = sum;
         }
-        // Scatter in input order within each cell: deterministic.
-        let mut next = self.cell_start.clone();
+        // Scatter in input order within each block: deterministic.
+        let len = self.scratch.len();
         self.entries.clear();
-        self.entries
-            .resize(self.scratch.len(), self.scratch.first().copied().unwrap_or(EMPTY));
-        for (n, &c) in self.scratch.iter().zip(&self.cell_of_entry) {
-            let slot = &mut next[c as usize];
+        self.entries.resize(len, self.scratch.first().copied().unwrap_or(EMPTY));
+        self.entry_cell.clear();
+        self.entry_cell.resize(len, 0);
+        for (n, &(b, c)) in self.scratch.iter().zip(&self.keys) {
+            let slot = &mut self.block_start[b as usize + 1];
             self.entries[*slot as usize] = *n;
+            self.entry_cell[*slot as usize] = c;
             *slot += 1;
+        }
+        // Then by cell within each block, stably (a block holds a creature or two: insertion).
+        for i in 1..len {
+            let c = self.entry_cell[i];
+            let mut j = i;
+            while j > 0 && self.entry_cell[j - 1] > c {
+                j -= 1;
+            }
+            if j < i {
+                self.entries[j..=i].rotate_right(1);
+                self.entry_cell[j..=i].rotate_right(1);
+            }
         }
     }
 
@@ -97,13 +130,18 @@ impl NeighbourGrid {
         let (x1, y1) = self.cell_xy(p + Vec2::splat(radius));
         let r2 = radius * radius;
         for y in y0..=y1 {
-            let row = y * self.cols;
+            let blocks = y * self.block_cols;
             let (a, b) = (
-                self.cell_start[(row + x0) as usize],
-                self.cell_start[(row + x1 + 1) as usize],
+                self.block_start[(blocks + x0 / BLOCK_CELLS) as usize] as usize,
+                self.block_start[(blocks + x1 / BLOCK_CELLS + 1) as usize] as usize,
             );
-            for n in &self.entries[a as usize..b as usize] {
-                if n.position.distance_squared(p) <= r2 {
+            // The blocks' entries in cells x0..=x1 of this row (they are in the order of their cells).
+            let (first, last) = (y * self.cols + x0, y * self.cols + x1);
+            for (n, &c) in self.entries[a..b].iter().zip(&self.entry_cell[a..b]) {
+                if c > last {
+                    break;
+                }
+                if c >= first && n.position.distance_squared(p) <= r2 {
                     f(n);
                 }
             }
