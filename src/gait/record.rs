@@ -161,16 +161,22 @@ fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &Record
             }
         }
         if sim.clock().seconds() > f64::from(s.settle_s + s.steady_within_s) {
+            let steadiest = if steadiest.0.is_finite() {
+                format!(
+                    "; the steadiest {} had periods {:.1} % apart (at most {:.1} %) and speeds {:.3} m/s apart (at most {})",
+                    s.hops,
+                    steadiest.0 * 100.0,
+                    s.steady_period_share * 100.0,
+                    steadiest.1,
+                    s.steady_speed_m_per_s
+                )
+            } else {
+                format!(", too few to judge {} of them", s.hops)
+            };
             return Err(format!(
-                "no steady gait at {speed} m/s within {} s: {} strides; the steadiest {} had periods \
-                 {:.1} % apart (at most {:.1} %) and speeds {:.3} m/s apart (at most {})",
+                "no steady gait at {speed} m/s within {} s: {} strides{steadiest}",
                 s.steady_within_s,
-                stride_starts.len(),
-                s.hops,
-                steadiest.0 * 100.0,
-                s.steady_period_share * 100.0,
-                steadiest.1,
-                s.steady_speed_m_per_s
+                stride_starts.len()
             ));
         }
     };
