@@ -184,16 +184,39 @@ struct Against {
     /// interpolated in log speed-up between the radii on either side.
     fixed_difference: f64,
     fixed_se_difference: f64,
-    /// The budget's outcome is nearer all rigid's than the fixed radii's by more than two
-    /// standard errors of the gap.
+    /// How much nearer all rigid's outcome the budget's is than the fixed radii's (negative:
+    /// farther), and its standard error, both from each trial's pair of games: where the two
+    /// differences have the same sign the all-rigid game cancels out of each trial's gap.
+    gap: f64,
+    se_gap: f64,
+    /// The gap is over two of its standard errors.
     nearer_beyond_2_se: bool,
+}
+
+/// Mean, standard deviation and standard error of the mean.
+fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let var = if values.len() > 1 {
+        values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    (mean, var.sqrt(), (var / n).sqrt())
 }
 
 /// Each budget point that lies within the fixed-radius curve's range of speed-ups, against
 /// that curve at its speed-up (figure 10's axes: the nearer zero the difference, the better).
-fn against_fixed(fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
+/// Trial by trial, the fixed radii's difference is interpolated between the two radii on either
+/// side, and the gap is how much nearer zero the budget's is, the signs those of the means.
+fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
     let mut curve: Vec<&Point> = fixed.to_vec();
     curve.sort_by(|a, b| a.speedup.total_cmp(&b.speedup));
+    let differences = |setting: Setting| -> Vec<f64> {
+        let mut at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
+        at.sort_by_key(|r| r.trial);
+        at.iter().map(|r| r.difference()).collect()
+    };
     budget
         .iter()
         .filter_map(|b| {
@@ -204,7 +227,17 @@ fn against_fixed(fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
             let w = (b.speedup / lo.speedup).ln() / (hi.speedup / lo.speedup).ln().max(1e-12);
             let at = |f: fn(&Point) -> f64| f(lo) + w * (f(hi) - f(lo));
             let (fixed_difference, fixed_se_difference) = (at(|p| p.mean_difference), at(|p| p.se_difference));
-            let gap = fixed_difference.abs() - b.mean_difference.abs();
+            let (sign_fixed, sign_budget) = (fixed_difference.signum(), b.mean_difference.signum());
+            let (d_lo, d_hi) = (
+                differences(Setting::Radius(lo.setting)),
+                differences(Setting::Radius(hi.setting)),
+            );
+            let gaps: Vec<f64> = differences(Setting::Budget(b.setting))
+                .iter()
+                .zip(d_lo.iter().zip(&d_hi))
+                .map(|(d_b, (d_lo, d_hi))| sign_fixed * (d_lo + w * (d_hi - d_lo)) - sign_budget * d_b)
+                .collect();
+            let (gap, _, se_gap) = mean_sd_se(&gaps);
             Some(Against {
                 budget_ms: b.setting,
                 speedup: b.speedup,
@@ -212,7 +245,9 @@ fn against_fixed(fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
                 se_difference: b.se_difference,
                 fixed_difference,
                 fixed_se_difference,
-                nearer_beyond_2_se: gap > 2.0 * b.se_difference.hypot(fixed_se_difference),
+                gap,
+                se_gap,
+                nearer_beyond_2_se: gap > 2.0 * se_gap,
             })
         })
         .collect()
@@ -225,23 +260,16 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
             let at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
             let n = at.len() as f64;
             let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
-            let mean_difference = mean(&|r| r.difference());
-            let var = if at.len() > 1 {
-                at.iter()
-                    .map(|r| (r.difference() - mean_difference).powi(2))
-                    .sum::<f64>()
-                    / (n - 1.0)
-            } else {
-                0.0
-            };
+            let (mean_difference, sd_difference, se_difference) =
+                mean_sd_se(&at.iter().map(|r| r.difference()).collect::<Vec<_>>());
             Point {
                 policy: setting.policy(),
                 setting: setting.value(),
                 trials: at.len(),
                 mean_difference,
                 mean_abs_difference: mean(&|r| r.difference().abs()),
-                sd_difference: var.sqrt(),
-                se_difference: (var / n).sqrt(),
+                sd_difference,
+                se_difference,
                 mean_rigid: mean(&|r| r.mean_rigid),
                 speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
             }
@@ -362,7 +390,7 @@ fn finish(
     }
     let curve = |policy: &str| -> Vec<&Point> { points.iter().filter(|p| p.policy == policy).collect() };
     let (fixed, budget) = (curve("influence"), curve("budget"));
-    let against = against_fixed(&fixed, &budget);
+    let against = against_fixed(rows, &fixed, &budget);
     let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, p.speedup)).collect::<Vec<_>>();
     let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
         ps.iter()
@@ -443,19 +471,23 @@ fn finish(
     let _ = write!(
         report,
         "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; budgets outside \
-         its range of speed-ups are left out). Nearer zero is nearer all rigid's outcome.\n\n\
-         | budget | speed-up | difference +- s.e. | fixed radii at that speed-up | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|\n"
+         its range of speed-ups are left out). Nearer zero is nearer all rigid's outcome. The gap is how much nearer the budget's \
+         is, taken trial by trial: each trial's budget game against its fixed-radius games, so that the all-rigid game's chance \
+         cancels where both differences have the same sign.\n\n\
+         | budget | speed-up | difference +- s.e. | fixed radii at that speed-up | gap +- s.e. (trial by trial) | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|---|\n"
     );
     for a in &against {
         let _ = writeln!(
             report,
-            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
+            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
             a.budget_ms,
             a.speedup,
             a.difference,
             a.se_difference,
             a.fixed_difference,
             a.fixed_se_difference,
+            a.gap,
+            a.se_gap,
             if a.nearer_beyond_2_se { "yes" } else { "no" }
         );
     }
@@ -486,37 +518,54 @@ fn finish(
 mod tests {
     use super::*;
 
-    fn point(policy: &'static str, setting: f32, speedup: f64, mean_difference: f64, se_difference: f64) -> Point {
-        Point {
-            policy,
-            setting,
-            trials: 10,
-            mean_difference,
-            mean_abs_difference: mean_difference.abs(),
-            sd_difference: se_difference * 10f64.sqrt(),
-            se_difference,
-            mean_rigid: 0.0,
-            speedup,
-        }
+    /// Trials whose all-rigid games collide 0, 10, 0, 10 times; the game at `setting` collides
+    /// `collided` each time, its wall time over all rigid's 8 s giving the speed-up.
+    fn trials(setting: Setting, collided: u64, wall_s: f64) -> Vec<Row> {
+        (0..4)
+            .map(|trial| Row {
+                setting,
+                trial,
+                seed: u64::from(trial),
+                collided,
+                collided_all_rigid: 10 * u64::from(trial % 2),
+                mean_rigid: 0.0,
+                wall_s,
+                wall_s_all_rigid: 8.0,
+            })
+            .collect()
     }
 
     #[test]
-    fn a_budget_is_weighed_against_the_fixed_radii_interpolated_at_its_speedup() {
-        let fixed = [
-            point("influence", 8.0, 2.0, -1.0, 0.1),
-            point("influence", 0.0, 8.0, -0.2, 0.1),
+    fn a_budget_is_weighed_against_the_fixed_radii_at_its_speedup_trial_by_trial() {
+        let settings = [
+            Setting::Radius(8.0),
+            Setting::Radius(0.0),
+            Setting::Budget(1.0),
+            Setting::Budget(2.0),
+            Setting::Budget(0.5),
         ];
-        let budget = [
-            point("budget", 1.0, 4.0, 0.0, 0.05),
-            point("budget", 2.0, 4.0, -0.7, 0.05),
-            point("budget", 0.5, 16.0, 0.0, 0.05),
-        ];
-        let against = against_fixed(&fixed.iter().collect::<Vec<_>>(), &budget.iter().collect::<Vec<_>>());
-        // 4 is halfway from 2 to 8 in log speed-up; 16 is past the curve's end.
-        assert_eq!(against.len(), 2);
-        assert!((against[0].fixed_difference + 0.6).abs() < 1e-9, "{against:?}");
-        assert!((against[0].fixed_se_difference - 0.1).abs() < 1e-9);
-        assert!(against[0].nearer_beyond_2_se, "0.6 nearer, 2 s.e. is 0.22");
-        assert!(!against[1].nearer_beyond_2_se, "farther than the curve");
+        // Speed-ups 2 and 8; the budgets at 4 (halfway in log speed-up), 4 and 16 (past the
+        // curve's end).
+        let rows: Vec<Row> = [(2, 4.0), (2, 1.0), (3, 2.0), (14, 2.0), (3, 0.5)]
+            .into_iter()
+            .zip(settings)
+            .flat_map(|((collided, wall_s), setting)| trials(setting, collided, wall_s))
+            .collect();
+        let points = summarise(&rows, &settings);
+        let [fixed, budget] =
+            ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
+        let against = against_fixed(&rows, &fixed, &budget);
+        assert_eq!(against.len(), 2, "{against:?}");
+        // Differences of -3 and -2 on average, each with a standard error of 2.9 from the
+        // all-rigid games alone; trial by trial the budget is 1 nearer every time.
+        let (one_ms, two_ms) = (&against[0], &against[1]);
+        assert!((one_ms.fixed_difference + 3.0).abs() < 1e-9, "{one_ms:?}");
+        assert!((one_ms.difference + 2.0).abs() < 1e-9);
+        assert!(one_ms.se_difference > 2.0);
+        assert!((one_ms.gap - 1.0).abs() < 1e-9 && one_ms.se_gap < 1e-9);
+        assert!(one_ms.nearer_beyond_2_se);
+        // +9 against -3: farther.
+        assert!((two_ms.gap + 6.0).abs() < 1e-9, "{two_ms:?}");
+        assert!(!two_ms.nearer_beyond_2_se);
     }
 }
