@@ -250,6 +250,9 @@ struct ScenarioArgs {
     /// Overrides the camera's radius of influence (metres).
     #[arg(long, value_parser = non_negative_metres)]
     camera_radius: Option<f32>,
+    /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s, 0 to 10000).
+    #[arg(long, value_parser = frame_budget_ms)]
+    frame_budget: Option<f32>,
     /// Overrides the scenario's level rules file.
     #[arg(long)]
     rules: Option<PathBuf>,
@@ -264,6 +267,15 @@ fn non_negative_metres(s: &str) -> Result<f32, String> {
         Ok(v)
     } else {
         Err(format!("must be between 0 and 10000 metres, got {v}"))
+    }
+}
+
+fn frame_budget_ms(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if v.is_finite() && (0.0..=1e4).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be between 0 and 10000 ms, got {v}"))
     }
 }
 
@@ -292,6 +304,9 @@ impl ScenarioArgs {
         }
         if let Some(r) = self.camera_radius {
             config.rules.camera.radius_m = r;
+        }
+        if let Some(ms) = self.frame_budget {
+            config.rules.budget.frame_budget_ms = ms;
         }
         if let Some(n) = self.solver_iterations {
             config.scenario.solver_iterations = n;

@@ -56,6 +56,30 @@ fn run_json_has_the_keys_of_the_summary() {
     assert_eq!(by_level, summary["falls"], "every fall is at one level: {summary}");
 }
 
+#[test]
+fn the_frame_budget_flag_sets_the_budget_the_run_keeps_to() {
+    let out = simlod(&[
+        "run",
+        "--seconds",
+        "2",
+        "--policy",
+        "budget",
+        "--frame-budget",
+        "0.3",
+        "--json",
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let budget = &summary["budget"];
+    assert!(
+        (budget["frame_budget_ms"].as_f64().unwrap() - 0.3).abs() < 1e-6,
+        "{budget}"
+    );
+    assert!(budget["predicted_ms_max"].as_f64().unwrap() <= 0.3 + 1e-6, "{budget}");
+    // Room for two or three rigid creatures of the 40 (a rigid hopper is 78.5 us in costs.ron).
+    assert!(summary["levels_mean"]["rigid"].as_f64().unwrap() < 5.0, "{summary}");
+}
+
 /// A user's mistake is one clear message and exit status 2, never a panic.
 fn refused(args: &[&str], says: &str) {
     let out = simlod(args);
@@ -71,6 +95,8 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
     refused(&["run", "--seconds", "soon"], "soon");
     refused(&["run", "--seconds", "1e6"], "10000");
     refused(&["run", "--puck-radius", "-3"], "-3");
+    refused(&["run", "--frame-budget=-1"], "10000 ms");
+    refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["run", "--scenario", "assets/scenarios/nowhere.ron"], "nowhere.ron");
     refused(
         &[
