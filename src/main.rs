@@ -261,22 +261,22 @@ struct ScenarioArgs {
     solver_iterations: Option<u32>,
 }
 
-fn non_negative_metres(s: &str) -> Result<f32, String> {
+/// A number from 0 to 10000 `unit`.
+fn up_to_ten_thousand(s: &str, unit: &str) -> Result<f32, String> {
     let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
     if v.is_finite() && (0.0..=1e4).contains(&v) {
         Ok(v)
     } else {
-        Err(format!("must be between 0 and 10000 metres, got {v}"))
+        Err(format!("must be between 0 and 10000 {unit}, got {v}"))
     }
 }
 
+fn non_negative_metres(s: &str) -> Result<f32, String> {
+    up_to_ten_thousand(s, "metres")
+}
+
 fn frame_budget_ms(s: &str) -> Result<f32, String> {
-    let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
-    if v.is_finite() && (0.0..=1e4).contains(&v) {
-        Ok(v)
-    } else {
-        Err(format!("must be between 0 and 10000 ms, got {v}"))
-    }
+    up_to_ten_thousand(s, "ms")
 }
 
 impl ScenarioArgs {

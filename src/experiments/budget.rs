@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
-use super::{ExperimentRecord, Options, command, load_settings, run_parallel, timed_game, trials};
+use super::{ExperimentRecord, Options, command, load_settings, mean_and_variance, run_parallel, timed_game, trials};
 use crate::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
 use crate::headless;
 use crate::lod::{LevelPolicy, Lod};
@@ -195,14 +195,8 @@ struct Against {
 
 /// Mean, standard deviation and standard error of the mean.
 fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    let var = if values.len() > 1 {
-        values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
-    } else {
-        0.0
-    };
-    (mean, var.sqrt(), (var / n).sqrt())
+    let (mean, variance) = mean_and_variance(values);
+    (mean, variance.sqrt(), (variance / values.len() as f64).sqrt())
 }
 
 /// Each budget point that lies within the fixed-radius curve's range of speed-ups, against

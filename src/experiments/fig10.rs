@@ -11,7 +11,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::plot::{self, Mark, Panel, Series};
-use super::{ExperimentRecord, Options, command, load_settings, run_parallel, trials};
+use super::{ExperimentRecord, Options, command, load_settings, mean_and_variance, run_parallel, trials};
 use crate::config::{LevelRules, SimConfig, Validate, Validator, load_file};
 use crate::headless;
 use crate::lod::{LevelPolicy, Lod};
@@ -331,18 +331,9 @@ fn summarise(rows: &[Row]) -> Vec<RadiusSummary> {
             let at: Vec<&Row> = rows.iter().filter(|r| r.puck_radius_m == radius).collect();
             let n = at.len() as f64;
             let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
-            let variance = |f: &dyn Fn(&Row) -> f64| {
-                let m = mean(f);
-                if at.len() > 1 {
-                    at.iter().map(|r| (f(r) - m).powi(2)).sum::<f64>() / (n - 1.0)
-                } else {
-                    0.0
-                }
-            };
-            let difference = |r: &Row| r.difference() as f64;
-            let falls_difference = |r: &Row| r.falls as f64 - r.falls_all_rigid as f64;
-            let mean_difference = mean(&difference);
-            let variance_difference = variance(&difference);
+            let of = |f: &dyn Fn(&Row) -> f64| mean_and_variance(&at.iter().map(|r| f(r)).collect::<Vec<_>>());
+            let (mean_difference, variance_difference) = of(&|r| r.difference() as f64);
+            let (mean_falls_difference, variance_falls_difference) = of(&|r| r.falls as f64 - r.falls_all_rigid as f64);
             let wall_s = at.iter().map(|r| r.wall_s).sum::<f64>();
             let wall_s_all_rigid = at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>();
             RadiusSummary {
@@ -354,8 +345,8 @@ fn summarise(rows: &[Row]) -> Vec<RadiusSummary> {
                 mean_collided_all_rigid: mean(&|r| r.collided_all_rigid as f64),
                 mean_falls: mean(&|r| r.falls as f64),
                 mean_falls_all_rigid: mean(&|r| r.falls_all_rigid as f64),
-                mean_falls_difference: mean(&falls_difference),
-                standard_error_falls_difference: (variance(&falls_difference) / n).sqrt(),
+                mean_falls_difference,
+                standard_error_falls_difference: (variance_falls_difference / n).sqrt(),
                 mean_rigid: mean(&|r| r.mean_rigid),
                 wall_s,
                 wall_s_all_rigid,

@@ -226,6 +226,18 @@ impl ExperimentRecord {
 }
 
 /// The median of some values (NaN if there are none).
+/// The mean of `values` and their sample variance (0 for a single value).
+pub fn mean_and_variance(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    let variance = if values.len() > 1 {
+        values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)
+    } else {
+        0.0
+    };
+    (mean, variance)
+}
+
 pub fn median_of(values: impl IntoIterator<Item = f64>) -> f64 {
     let v: Vec<f64> = values.into_iter().collect();
     if v.is_empty() {
