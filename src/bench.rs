@@ -268,9 +268,10 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
     }
 }
 
-/// `simlod bench --calibrate`: the budget policy's cost model from measured medians. For each
-/// kind of the scenario alone, in a court scaled to its density: each level's median frame
-/// divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so one thread, as in
+/// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
+/// fixed cost of a frame: the scenario's court and puck without creatures. Then for each
+/// kind of the scenario alone, in a court scaled to its density: each level's median frame,
+/// less the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so one thread, as in
 /// a game), and the switch into the rigid level: the frames in which a crowd of them goes
 /// rigid, less what their levels cost in those frames, per switch. A kind without an entry is
 /// predicted at the dearest calibrated kind's costs.
@@ -278,6 +279,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
     let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
     let kinds = KindTable::of(config);
+    let fixed_us = median_of_runs(&scaled(config, 0, LevelPolicy::AllPointMass), runs, warmup, frames) * 1e6;
     let mut entries = Vec::new();
     for def in &config.kinds {
         let alone = crate::experiments::only_kind(config, &def.name);
@@ -290,7 +292,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
             let frame_s = median_of_runs(&scaled(&alone, count, policy), runs, warmup, frames);
-            us[level as usize] = frame_s * 1e6 / f64::from(count);
+            us[level as usize] = (frame_s * 1e6 - fixed_us).max(0.0) / f64::from(count);
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -327,6 +329,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     CostModel {
         kinds: entries,
         other_kinds,
+        fixed_us_per_frame: fixed_us as f32,
     }
 }
 
@@ -355,6 +358,6 @@ pub fn costs_file_text(model: &CostModel, command: &str) -> String {
     let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
     let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
     format!(
-        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, and of a switch into the rigid level, in microseconds (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, and of a frame whatever its creatures (the court,\n// the puck, the schedule), in microseconds (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
     )
 }

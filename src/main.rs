@@ -439,6 +439,10 @@ impl BenchArgs {
                     c.switch_to_rigid_us
                 );
             }
+            println!(
+                "  a frame whatever its creatures (court, puck, schedule): {:.1}",
+                model.fixed_us_per_frame
+            );
         }
         Ok(())
     }

@@ -15,6 +15,11 @@ pub struct CostModel {
     pub kinds: Vec<KindCosts>,
     /// What a kind without an entry is predicted to cost.
     pub other_kinds: LevelCosts,
+    /// What a frame costs whatever its creatures (the court, the puck, the schedule's ticks),
+    /// in microseconds per 1/30 s: taken from the budget before any creature's level. A file
+    /// without it predicts 0.
+    #[serde(default)]
+    pub fixed_us_per_frame: f32,
 }
 
 /// A kind's costs, by name.
@@ -27,7 +32,7 @@ pub struct KindCosts {
 
 /// Wall time of one creature's 1/30 s of simulated motion at each level (steering, collisions
 /// and its model), and of a switch into the rigid level (building its bodies), in
-/// microseconds; each 0 to 1,000,000 us.
+/// microseconds; each 0 to 1,000,000 us (as is the model's fixed cost of a frame).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LevelCosts {
@@ -47,12 +52,19 @@ impl LevelCosts {
         }
     }
 
+    /// The most any cost may be, in microseconds.
+    const MOST_US: f32 = 1_000_000.0;
+
     fn validate(&self, v: &mut Validator) {
-        const MOST_US: f32 = 1_000_000.0;
-        v.within("point_mass_us_per_frame", self.point_mass_us_per_frame, 0.0, MOST_US);
-        v.within("hybrid_us_per_frame", self.hybrid_us_per_frame, 0.0, MOST_US);
-        v.within("rigid_us_per_frame", self.rigid_us_per_frame, 0.0, MOST_US);
-        v.within("switch_to_rigid_us", self.switch_to_rigid_us, 0.0, MOST_US);
+        v.within(
+            "point_mass_us_per_frame",
+            self.point_mass_us_per_frame,
+            0.0,
+            Self::MOST_US,
+        );
+        v.within("hybrid_us_per_frame", self.hybrid_us_per_frame, 0.0, Self::MOST_US);
+        v.within("rigid_us_per_frame", self.rigid_us_per_frame, 0.0, Self::MOST_US);
+        v.within("switch_to_rigid_us", self.switch_to_rigid_us, 0.0, Self::MOST_US);
     }
 }
 
@@ -78,5 +90,26 @@ impl Validate for CostModel {
             }
         }
         v.nested("other_kinds", |v| self.other_kinds.validate(v));
+        v.within("fixed_us_per_frame", self.fixed_us_per_frame, 0.0, LevelCosts::MOST_US);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::parse_ron;
+    use std::path::Path;
+
+    const COSTS: &str =
+        "(point_mass_us_per_frame: 1, hybrid_us_per_frame: 2, rigid_us_per_frame: 100, switch_to_rigid_us: 50)";
+
+    #[test]
+    fn a_cost_model_written_before_the_fixed_cost_loads_with_none() {
+        let old = format!("(kinds: [], other_kinds: {COSTS})");
+        let model: CostModel = parse_ron(old.as_bytes(), Path::new("costs.ron")).unwrap();
+        assert_eq!(model.fixed_us_per_frame, 0.0);
+        let negative = format!("(kinds: [], other_kinds: {COSTS}, fixed_us_per_frame: -3)");
+        let err = parse_ron::<CostModel>(negative.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(err.to_string().contains("`fixed_us_per_frame`"), "{err}");
     }
 }

@@ -8,7 +8,8 @@
 //! creature could come (a time to contact from positions and velocities, where 3.4 has areas
 //! of influence), and how much the viewer sees of it (in view, how near the camera, the
 //! followed creature first; 3.4's camera rule). Each level has a predicted cost from the cost
-//! model (`assets/costs.ron`), and going rigid costs the building of its bodies once more.
+//! model (`assets/costs.ron`), and going rigid costs the building of its bodies once more;
+//! what a frame costs whatever its creatures (the court, the puck) comes off the budget first.
 //! The levels are chosen as a multiple-choice knapsack, greedily by benefit per cost
 //! (Funkhouser & Sequin, SIGGRAPH '93), so that the predicted cost of the frame stays within
 //! the budget. It starts from the last decision: a creature in its dwell keeps at least its
@@ -393,7 +394,10 @@ fn decide(
             }
         })
         .collect();
-    let allocation = allocate(&candidates, budget_us, config.rules.budget.hysteresis);
+    // The frame's fixed cost (court, puck, schedule) comes off the budget first.
+    let fixed_us = config.costs.fixed_us_per_frame;
+    let mut allocation = allocate(&candidates, budget_us - fixed_us, config.rules.budget.hysteresis);
+    allocation.predicted_us += fixed_us;
     (rows.iter().map(|r| r.0).collect(), allocation)
 }
 

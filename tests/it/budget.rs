@@ -25,6 +25,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
     config.costs = CostModel {
         kinds: vec![],
         other_kinds: COSTS,
+        fixed_us_per_frame: 0.0,
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config
@@ -146,6 +147,38 @@ fn a_budget_too_small_for_the_cheapest_levels_gives_them_and_says_it_was_exceede
     assert!(budget.decisions > 0);
     assert_eq!(budget.decisions_over_budget, budget.decisions);
     assert!(budget.predicted_ms_max >= 0.02 - 1e-6, "{budget:?}");
+}
+
+#[test]
+fn the_fixed_cost_of_a_frame_comes_off_the_budget_before_any_creature() {
+    // 30 hoppers, 0.6 ms: room for four or five rigid ones. With a frame's fixed cost of
+    // 0.45 ms the creatures have 0.15 ms: one going rigid (100 + 50 us) does not fit beside
+    // 29 point masses, and the prediction counts the fixed cost.
+    let budget_ms = 0.6;
+    let mut config = budget_scene(30, budget_ms);
+    config.costs.fixed_us_per_frame = 450.0;
+    let mut sim = HeadlessSim::new(config.clone());
+    let mut rigid_seen = 0;
+    for _ in 0..(10 * 30) {
+        sim.advance_frame();
+        let tally = sim.app.world().resource::<BudgetTally>().clone();
+        assert!(
+            tally.predicted_us() >= 450.0 && tally.predicted_us() <= budget_ms * 1e3,
+            "{tally:?}"
+        );
+        let world = sim.app.world_mut();
+        rigid_seen = rigid_seen.max(world.query::<&Lod>().iter(world).filter(|&&l| l == Lod::Rigid).count());
+    }
+    assert!(rigid_seen <= 1, "{rigid_seen} rigid at once");
+    assert_eq!(sim.summary(0.0).budget.unwrap().decisions_over_budget, 0);
+    // A fixed cost beyond the budget leaves every creature at its cheapest, and says so.
+    config.costs.fixed_us_per_frame = 700.0;
+    let mut sim = HeadlessSim::new(config);
+    sim.run_for(3.0);
+    let summary = sim.summary(0.0);
+    assert_eq!(summary.levels[Lod::PointMass], 30, "{:?}", summary.levels);
+    let budget = summary.budget.unwrap();
+    assert_eq!(budget.decisions_over_budget, budget.decisions);
 }
 
 /// Runs `seconds` of a budget scene, telling the policy after each frame that it took

@@ -81,6 +81,23 @@ fn the_frame_budget_flag_sets_the_budget_the_run_keeps_to() {
 }
 
 /// A user's mistake is one clear message and exit status 2, never a panic.
+#[test]
+fn calibrating_writes_a_cost_model_the_budget_policy_loads_with_a_fixed_cost_per_frame() {
+    let dir = std::env::temp_dir().join(format!("simlod-calibrate-{}", std::process::id()));
+    let file = dir.join("costs.ron");
+    let out = simlod(&["bench", "--calibrate", "--quick", "--out", file.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let model: simlod::config::CostModel = simlod::config::load_file(&file).expect("a valid cost model");
+    std::fs::remove_dir_all(&dir).ok();
+    // The court and the puck cost something whatever the creatures; a rigid creature far more
+    // than a hybrid one, of every kind the scenario has.
+    assert!(model.fixed_us_per_frame > 0.0, "{model:?}");
+    assert_eq!(model.kinds.len(), 2, "{model:?}");
+    for k in &model.kinds {
+        assert!(k.costs.rigid_us_per_frame > 10.0 * k.costs.hybrid_us_per_frame, "{k:?}");
+    }
+}
+
 fn refused(args: &[&str], says: &str) {
     let out = simlod(args);
     let stderr = String::from_utf8_lossy(&out.stderr);
