@@ -269,7 +269,8 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 }
 
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
-/// fixed cost of a frame: the scenario's court and puck without creatures. Then for each
+/// fixed cost of a frame: the scenario's court and puck without creatures; and the budget
+/// policy's own choice, per creature, in the scenario's mix scaled up. Then for each
 /// kind of the scenario alone, in a court scaled to its density: each level's median frame,
 /// less the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so one thread, as in
 /// a game), and the switch into the rigid level: the frames in which a crowd of them goes
@@ -279,7 +280,13 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
     let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
     let kinds = KindTable::of(config);
-    let fixed_us = median_of_runs(&scaled(config, 0, LevelPolicy::AllPointMass), runs, warmup, frames) * 1e6;
+    // Cheap to measure and in every other figure: many frames, many runs.
+    let fixed_us = median_of_runs(
+        &scaled(config, 0, LevelPolicy::AllPointMass),
+        3 * runs,
+        warmup,
+        5 * frames,
+    ) * 1e6;
     let mut entries = Vec::new();
     for def in &config.kinds {
         let alone = crate::experiments::only_kind(config, &def.name);
@@ -326,11 +333,34 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
         rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
         switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
     };
-    CostModel {
+    let mut model = CostModel {
         kinds: entries,
         other_kinds,
         fixed_us_per_frame: fixed_us as f32,
-    }
+        decision_us_per_creature: 0.0,
+    };
+    // The budget policy's own choice: the scenario's crowd choosing under this model with a
+    // budget below the fixed cost (so every creature keeps its cheapest level), against the
+    // same crowd all point masses.
+    let mut choosing = config.clone();
+    (choosing.costs, choosing.rules.budget.frame_budget_ms) = (model.clone(), 0.0);
+    let choosing_us = median_of_runs(
+        &scaled(&choosing, cheap_count, LevelPolicy::Budget),
+        runs,
+        warmup,
+        frames,
+    ) * 1e6;
+    let decision_us = (choosing_us
+        - median_of_runs(
+            &scaled(config, cheap_count, LevelPolicy::AllPointMass),
+            runs,
+            warmup,
+            frames,
+        ) * 1e6)
+        .max(0.0)
+        / f64::from(cheap_count);
+    model.decision_us_per_creature = decision_us as f32;
+    model
 }
 
 /// Microseconds per switch into the rigid level (building a creature's bodies): a world of
@@ -358,6 +388,6 @@ pub fn costs_file_text(model: &CostModel, command: &str) -> String {
     let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
     let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
     format!(
-        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, and of a frame whatever its creatures (the court,\n// the puck, the schedule), in microseconds (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature, in microseconds\n// (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
     )
 }

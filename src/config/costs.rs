@@ -8,7 +8,7 @@ use crate::lod::Lod;
 use serde::{Deserialize, Serialize};
 
 /// Predicted costs per kind and level.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CostModel {
     /// One entry per calibrated kind.
@@ -20,6 +20,11 @@ pub struct CostModel {
     /// without it predicts 0.
     #[serde(default)]
     pub fixed_us_per_frame: f32,
+    /// What the budget policy's own choice costs per creature per 1/30 s (its benefits and
+    /// the knapsack), in microseconds: taken from the budget with the fixed cost. A file
+    /// without it predicts 0.
+    #[serde(default)]
+    pub decision_us_per_creature: f32,
 }
 
 /// A kind's costs, by name.
@@ -33,7 +38,7 @@ pub struct KindCosts {
 /// Wall time of one creature's 1/30 s of simulated motion at each level (steering, collisions
 /// and its model), and of a switch into the rigid level (building its bodies), in
 /// microseconds; each 0 to 1,000,000 us (as is the model's fixed cost of a frame).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LevelCosts {
     pub point_mass_us_per_frame: f32,
@@ -69,6 +74,12 @@ impl LevelCosts {
 }
 
 impl CostModel {
+    /// Predicted microseconds of a frame of `creatures` before any creature's level: the
+    /// fixed cost and the budget policy's choice.
+    pub fn overhead_us(&self, creatures: usize) -> f32 {
+        self.fixed_us_per_frame + self.decision_us_per_creature * creatures as f32
+    }
+
     /// The costs of the kind named `kind`.
     pub fn of(&self, kind: &str) -> &LevelCosts {
         self.kinds
@@ -91,6 +102,12 @@ impl Validate for CostModel {
         }
         v.nested("other_kinds", |v| self.other_kinds.validate(v));
         v.within("fixed_us_per_frame", self.fixed_us_per_frame, 0.0, LevelCosts::MOST_US);
+        v.within(
+            "decision_us_per_creature",
+            self.decision_us_per_creature,
+            0.0,
+            LevelCosts::MOST_US,
+        );
     }
 }
 
@@ -107,7 +124,7 @@ mod tests {
     fn a_cost_model_written_before_the_fixed_cost_loads_with_none() {
         let old = format!("(kinds: [], other_kinds: {COSTS})");
         let model: CostModel = parse_ron(old.as_bytes(), Path::new("costs.ron")).unwrap();
-        assert_eq!(model.fixed_us_per_frame, 0.0);
+        assert_eq!(model.overhead_us(100), 0.0);
         let negative = format!("(kinds: [], other_kinds: {COSTS}, fixed_us_per_frame: -3)");
         let err = parse_ron::<CostModel>(negative.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`fixed_us_per_frame`"), "{err}");

@@ -44,26 +44,34 @@ pub struct SimConfig {
     pub costs: CostModel,
 }
 
+/// What a command measures anew, and so need not load: `simlod record-gait` a kind's gait
+/// table, `simlod bench --calibrate` the cost model (which starts empty).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct MeasuredAnew<'a> {
+    pub gait_table_of: Option<&'a str>,
+    pub cost_model: bool,
+}
+
 impl SimConfig {
     /// Loads a scenario file and the arena and creature files it names, resolved against
     /// `assets_root` (`arena` is a path under it; a creature kind `k` is
     /// `creatures/k.ron`). Every problem is reported with the file it is in; a file that
     /// cannot be read, with the file and field that named it.
     pub fn load(scenario_path: &Path, assets_root: &Path) -> Result<Self, ConfigError> {
-        Self::load_without_table_of(scenario_path, assets_root, None)
+        Self::load_measuring(scenario_path, assets_root, MeasuredAnew::default())
     }
 
-    /// As [`SimConfig::load`], but kind `without` (if any) gets no gait table, whatever its
-    /// file says: `simlod record-gait` records it anew, even over a broken or outdated one.
-    pub fn load_without_table_of(
-        scenario_path: &Path,
-        assets_root: &Path,
-        without: Option<&str>,
-    ) -> Result<Self, ConfigError> {
+    /// As [`SimConfig::load`], but what is about to be measured anew is not loaded, whatever
+    /// its file says (even a broken, outdated or missing one): see [`MeasuredAnew`].
+    pub fn load_measuring(scenario_path: &Path, assets_root: &Path, anew: MeasuredAnew) -> Result<Self, ConfigError> {
         let scenario: Scenario = load_file(scenario_path)?;
         let arena = load_reference(assets_root, scenario_path, "arena", &scenario.arena)?;
         let rules: LevelRules = load_reference(assets_root, scenario_path, "level_rules", &scenario.level_rules)?;
-        let costs = load_costs(assets_root, &assets_root.join(&scenario.level_rules), &rules)?;
+        let costs = if anew.cost_model {
+            CostModel::default()
+        } else {
+            load_costs(assets_root, &assets_root.join(&scenario.level_rules), &rules)?
+        };
         Self::assemble(
             scenario_path,
             assets_root,
@@ -85,7 +93,7 @@ impl SimConfig {
                     ));
                 }
                 let mut def: CreatureDef = load_reference(assets_root, scenario_path, &field, &kind_file(kind))?;
-                if without == Some(kind) {
+                if anew.gait_table_of == Some(kind) {
                     def.gait_table = None;
                 }
                 Ok(def)

@@ -9,7 +9,8 @@
 //! of influence), and how much the viewer sees of it (in view, how near the camera, the
 //! followed creature first; 3.4's camera rule). Each level has a predicted cost from the cost
 //! model (`assets/costs.ron`), and going rigid costs the building of its bodies once more;
-//! what a frame costs whatever its creatures (the court, the puck) comes off the budget first.
+//! what a frame costs whatever its creatures' levels (the court, the puck, this choice) comes
+//! off the budget first.
 //! The levels are chosen as a multiple-choice knapsack, greedily by benefit per cost
 //! (Funkhouser & Sequin, SIGGRAPH '93), so that the predicted cost of the frame stays within
 //! the budget. It starts from the last decision: a creature in its dwell keeps at least its
@@ -310,18 +311,21 @@ impl Scene<'_> {
         let t = course(room.x, along.x).min(course(room.y, along.y));
         let gap = room.min_element().max(0.0);
         best = best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)));
-        // Other creatures.
+        // Other creatures: urgency falls with time, so only the soonest contacts count (one
+        // urgency per creature, not one per neighbour).
         if r.creature_weight > 0.0 {
+            let (mut t_course, mut t_worst) = (f32::INFINITY, f32::INFINITY);
+            let closing = (2.0 * self.top_speed).max(1e-3);
             self.grid.for_each_within(s.position, self.reach_m, |n| {
                 if n.serial == c.serial {
                     return;
                 }
                 let d = s.position - n.position;
                 let reach = radius + n.radius + margin;
-                let gap = (d.length() - reach).max(0.0);
-                let t = time_to_contact(d, s.velocity - n.velocity, reach);
-                best = best.max(r.creature_weight * self.urgency(t, gap / (2.0 * self.top_speed).max(1e-3)));
+                t_worst = t_worst.min((d.length() - reach).max(0.0) / closing);
+                t_course = t_course.min(time_to_contact(d, s.velocity - n.velocity, reach));
             });
+            best = best.max(r.creature_weight * self.urgency(t_course, t_worst));
         }
         best
     }
@@ -394,10 +398,10 @@ fn decide(
             }
         })
         .collect();
-    // The frame's fixed cost (court, puck, schedule) comes off the budget first.
-    let fixed_us = config.costs.fixed_us_per_frame;
-    let mut allocation = allocate(&candidates, budget_us - fixed_us, config.rules.budget.hysteresis);
-    allocation.predicted_us += fixed_us;
+    // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
+    let overhead_us = config.costs.overhead_us(candidates.len());
+    let mut allocation = allocate(&candidates, budget_us - overhead_us, config.rules.budget.hysteresis);
+    allocation.predicted_us += overhead_us;
     (rows.iter().map(|r| r.0).collect(), allocation)
 }
 

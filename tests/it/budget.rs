@@ -26,6 +26,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         kinds: vec![],
         other_kinds: COSTS,
         fixed_us_per_frame: 0.0,
+        decision_us_per_creature: 0.0,
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config
@@ -150,13 +151,14 @@ fn a_budget_too_small_for_the_cheapest_levels_gives_them_and_says_it_was_exceede
 }
 
 #[test]
-fn the_fixed_cost_of_a_frame_comes_off_the_budget_before_any_creature() {
+fn the_fixed_cost_and_the_choice_come_off_the_budget_before_any_creature() {
     // 30 hoppers, 0.6 ms: room for four or five rigid ones. With a frame's fixed cost of
-    // 0.45 ms the creatures have 0.15 ms: one going rigid (100 + 50 us) does not fit beside
-    // 29 point masses, and the prediction counts the fixed cost.
+    // 0.3 ms and a choice of 5 us per creature the levels have 0.15 ms: one going rigid
+    // (100 + 50 us) does not fit beside 29 point masses, and the prediction counts both.
     let budget_ms = 0.6;
     let mut config = budget_scene(30, budget_ms);
-    config.costs.fixed_us_per_frame = 450.0;
+    config.costs.fixed_us_per_frame = 300.0;
+    config.costs.decision_us_per_creature = 5.0;
     let mut sim = HeadlessSim::new(config.clone());
     let mut rigid_seen = 0;
     for _ in 0..(10 * 30) {
@@ -171,8 +173,8 @@ fn the_fixed_cost_of_a_frame_comes_off_the_budget_before_any_creature() {
     }
     assert!(rigid_seen <= 1, "{rigid_seen} rigid at once");
     assert_eq!(sim.summary(0.0).budget.unwrap().decisions_over_budget, 0);
-    // A fixed cost beyond the budget leaves every creature at its cheapest, and says so.
-    config.costs.fixed_us_per_frame = 700.0;
+    // An overhead beyond the budget leaves every creature at its cheapest, and says so.
+    config.costs.fixed_us_per_frame = 550.0;
     let mut sim = HeadlessSim::new(config);
     sim.run_for(3.0);
     let summary = sim.summary(0.0);

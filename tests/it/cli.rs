@@ -82,10 +82,32 @@ fn the_frame_budget_flag_sets_the_budget_the_run_keeps_to() {
 
 /// A user's mistake is one clear message and exit status 2, never a panic.
 #[test]
-fn calibrating_writes_a_cost_model_the_budget_policy_loads_with_a_fixed_cost_per_frame() {
+fn calibrating_writes_a_cost_model_that_loads_even_for_rules_whose_model_is_not_measured_yet() {
     let dir = std::env::temp_dir().join(format!("simlod-calibrate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // Rules naming a cost model that does not exist yet: running under them is refused, and
+    // calibrating them measures it.
+    let levels = std::fs::read_to_string("assets/rules/levels.ron").unwrap();
+    let rules = dir.join("new-rules.ron");
+    std::fs::write(
+        &rules,
+        levels.replace("\"costs.ron\"", "\"costs-not-measured-yet.ron\""),
+    )
+    .unwrap();
+    let rules = rules.to_str().unwrap();
+    let refused = simlod(&["run", "--seconds", "1", "--rules", rules]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("costs-not-measured-yet.ron"));
     let file = dir.join("costs.ron");
-    let out = simlod(&["bench", "--calibrate", "--quick", "--out", file.to_str().unwrap()]);
+    let out = simlod(&[
+        "bench",
+        "--calibrate",
+        "--quick",
+        "--rules",
+        rules,
+        "--out",
+        file.to_str().unwrap(),
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let model: simlod::config::CostModel = simlod::config::load_file(&file).expect("a valid cost model");
     std::fs::remove_dir_all(&dir).ok();
