@@ -269,13 +269,12 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 }
 
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
-/// fixed cost of a frame: the scenario's court and puck without creatures; and the budget
-/// policy's own choice, per creature, in the scenario's mix scaled up. Then for each
-/// kind of the scenario alone, in a court scaled to its density: each level's median frame,
-/// less the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so one thread, as in
-/// a game), and the switch into the rigid level: the frames in which a crowd of them goes
-/// rigid, less what their levels cost in those frames, per switch. A kind without an entry is
-/// predicted at the dearest calibrated kind's costs.
+/// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
+/// of the scenario alone, in a court scaled to its density: each level's median frame, less
+/// the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so
+/// one thread, as in a game), and the switch into the rigid level (see [`switch_cost_us`]). A
+/// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
+/// policy's own choice per creature, in the scenario's mix scaled up.
 pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
     let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
