@@ -332,6 +332,10 @@ struct PlayArgs {
     /// Overrides the scenario's level policy (L switches it while playing).
     #[arg(long, value_enum)]
     policy: Option<LevelPolicy>,
+    /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s, 0 to 10000; 9
+    /// and 0 change it while playing).
+    #[arg(long, value_parser = frame_budget_ms)]
+    frame_budget: Option<f32>,
     /// Render `--frames` frames, save the window to this PNG file and quit.
     #[arg(long, requires = "frames")]
     screenshot: Option<PathBuf>,
@@ -347,6 +351,7 @@ impl PlayArgs {
             scenario: self.scenario,
             assets: self.assets,
             policy: self.policy,
+            frame_budget_ms: self.frame_budget,
             screenshot: self.screenshot.zip(self.frames),
         })
     }

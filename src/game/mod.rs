@@ -28,6 +28,9 @@ pub struct PlayOptions {
     pub assets: PathBuf,
     /// Overrides the scenario's level policy.
     pub policy: Option<LevelPolicy>,
+    /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s), until the
+    /// rules file is edited.
+    pub frame_budget_ms: Option<f32>,
     /// Render this many frames, save a screenshot here and quit.
     pub screenshot: Option<(PathBuf, u32)>,
 }
@@ -45,8 +48,12 @@ pub const NO_DISPLAY: &str = "simlod cannot open the game window: no display is 
 /// Opens the game window and plays until it closes.
 pub fn play(options: PlayOptions) -> Result<(), String> {
     let mut config = SimConfig::load(&options.scenario, &options.assets).map_err(|e| e.to_string())?;
+    let file_rules = config.rules.clone();
     if let Some(policy) = options.policy {
         config.scenario.level_policy = policy;
+    }
+    if let Some(ms) = options.frame_budget_ms {
+        config.rules.budget.frame_budget_ms = ms;
     }
     let looks: GameConfig = load_file(&options.assets.join(GAME_FILE)).map_err(|e| e.to_string())?;
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
@@ -54,7 +61,7 @@ pub fn play(options: PlayOptions) -> Result<(), String> {
     add_window_plugins(&mut app, &options)?;
     app.add_plugins(SimPlugin { config })
         .insert_resource(GameSettings(looks))
-        .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone()));
+        .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone(), file_rules));
     plugin(&mut app);
     if let Some((path, frames)) = options.screenshot {
         screenshot::plugin(&mut app, path, frames);

@@ -2,8 +2,8 @@
 //! Bevy's asset server, which watches them. A good edit of a simulation file starts a new
 //! round from the edited files; a good edit of the level rules or of `game.ron` applies at
 //! once, in the running round. A bad edit is shown on screen and everything runs on with the
-//! last good values. The player's live tuning (level policy, radii of influence) survives
-//! every reload except, for the radii, an edit of the rules file itself.
+//! last good values. The player's live tuning (level policy, radii of influence, frame budget)
+//! survives every reload except, for the radii and the budget, an edit of the rules file itself.
 
 use bevy::asset::{AssetLoadError, AssetLoadFailedEvent, AssetPath, UntypedAssetId};
 use bevy::prelude::*;
@@ -33,12 +33,15 @@ pub struct Watched {
     gaits: HashMap<String, Handle<GaitTable>>,
     game: Handle<GameConfig>,
     changed: bool,
-    /// The level rules as the files last said: the player's radii stand until they change.
+    /// The level rules as the files last said: the player's radii and frame budget (the keys,
+    /// `--frame-budget`) stand until they change.
     file_rules: Option<LevelRules>,
 }
 
 impl Watched {
-    pub fn new(scenario_file: String, assets_root: PathBuf) -> Self {
+    /// Watches the scenario at `scenario_file` (under `assets_root`), whose rules file says
+    /// `file_rules` now (before the command line's overrides).
+    pub fn new(scenario_file: String, assets_root: PathBuf, file_rules: LevelRules) -> Self {
         Self {
             scenario_file,
             assets_root,
@@ -49,7 +52,7 @@ impl Watched {
             gaits: default(),
             game: default(),
             changed: false,
-            file_rules: None,
+            file_rules: Some(file_rules),
         }
     }
 
@@ -76,7 +79,6 @@ const ACROSS_FILES: &str = "";
 fn watch_files(server: Res<AssetServer>, base: Res<BaseConfig>, mut watched: ResMut<Watched>) {
     watched.scenario = server.load(watched.scenario_file.clone());
     watched.game = server.load(GAME_FILE);
-    watched.file_rules = Some(base.rules.clone());
     watched.arena = server.load(base.scenario.arena.clone());
     watched.rules = server.load(base.scenario.level_rules.clone());
     for kind in &base.kinds {

@@ -136,6 +136,7 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
     refused(&["run", "--puck-radius", "-3"], "-3");
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
+    refused(&["play", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--scenario", "assets/scenarios/nowhere.ron"], "nowhere.ron");
     refused(
         &[

@@ -74,7 +74,14 @@ fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
 
 /// The game's rules and hot reload on a copy of the assets, without a window.
 fn watching_app(root: &Path) -> App {
-    let config = SimConfig::load(&root.join("scenarios/default.ron"), root).unwrap();
+    watching_app_overriding(root, |_| {})
+}
+
+/// As [`watching_app`], with the command line's overrides made by `overrides`.
+fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) -> App {
+    let mut config = SimConfig::load(&root.join("scenarios/default.ron"), root).unwrap();
+    let file_rules = config.rules.clone();
+    overrides(&mut config);
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
@@ -85,7 +92,11 @@ fn watching_app(root: &Path) -> App {
         },
     ))
     .add_plugins(SimPlugin { config })
-    .insert_resource(Watched::new("scenarios/default.ron".to_owned(), root.to_path_buf()))
+    .insert_resource(Watched::new(
+        "scenarios/default.ron".to_owned(),
+        root.to_path_buf(),
+        file_rules,
+    ))
     .insert_resource(TimeUpdateStrategy::FixedTimesteps(8));
     simlod::game::player::plugin(&mut app);
     simlod::game::reload::plugin(&mut app);
@@ -173,6 +184,27 @@ fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restar
         "a new round with the edited file"
     );
     assert!(seconds(&mut app) < 1.0, "the world started over");
+}
+
+#[test]
+fn a_frame_budget_given_at_start_outlives_the_first_loads_and_yields_to_an_edit_of_the_rules() {
+    let root = copy_assets("frame_budget_override");
+    let mut app = watching_app_overriding(&root, |c| c.rules.budget.frame_budget_ms = 0.7);
+    let budget = |app: &mut App| app.world().resource::<SimConfig>().rules.budget.frame_budget_ms;
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(app.world().resource::<Problems>().0.is_empty());
+    assert_eq!(budget(&mut app), 0.7, "the files' first loads keep the override");
+    let rules = std::fs::read_to_string(root.join("rules/levels.ron")).unwrap();
+    assert!(rules.contains("frame_budget_ms: 4.0,"));
+    std::fs::write(
+        root.join("rules/levels.ron"),
+        rules.replacen("frame_budget_ms: 4.0,", "frame_budget_ms: 2.5,", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the edited budget", |app| budget(app) == 2.5);
 }
 
 #[test]
