@@ -511,6 +511,10 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         .map(|(k, v)| format!("{} {v:.1} (peak {})", k.name(), s.levels_peak[k]))
         .collect();
     println!("creatures per level on average: {}", mean.join(", "));
+    println!(
+        "frame as the cost model predicts it from the levels: {:.2} ms on average, {:.2} ms at the slowest",
+        s.predicted_frame.mean_ms, s.predicted_frame.slowest_ms
+    );
     let switches: Vec<String> = s
         .switches
         .directions()

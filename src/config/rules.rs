@@ -84,6 +84,11 @@ pub struct BudgetRules {
     /// A creature's last chosen level counts this share more benefit, so one near the cut-off
     /// does not flicker; 0 to 10.
     pub hysteresis: f32,
+    /// A level is bought only for at least this much benefit per ms of its predicted cost:
+    /// what would gain less is left unspent, so the budget is a ceiling, not a target.
+    /// 0 (the default) spends the budget wherever anything gains; 0 to 10^6.
+    #[serde(default)]
+    pub least_benefit_per_ms: f32,
     /// 0 (the default): the cost model alone predicts, and the same files give the same run.
     /// Above 0, the adaptive mode: the predictions are corrected by the measured simulation
     /// time of each frame, smoothed over about this many frames; it reads the wall clock, so
@@ -128,6 +133,7 @@ impl Validate for LevelRules {
             }
             v.range("view_half_distance_m", b.view_half_distance_m, 0.01, 10_000.0);
             v.within("hysteresis", b.hysteresis, 0.0, 10.0);
+            v.within("least_benefit_per_ms", b.least_benefit_per_ms, 0.0, 1e6);
             v.within("adaptive_frames", b.adaptive_frames, 0.0, 10_000.0);
         });
         let (a, b) = self.flight_window;

@@ -4,7 +4,9 @@
 //! 1. The trade-off: trials of a game from their own seeds, each all rigid, under the influence
 //!    policy at each fixed puck radius (figure 10's rule), and under the budget policy at each
 //!    frame budget; for each, the mean change in creatures that collided with the puck or a
-//!    wall against all rigid, and the speed-up (all-rigid wall time over the policy's).
+//!    wall against all rigid, and two speed-ups: of the wall time on average (figure 10's), and
+//!    of the slowest frame as the cost model predicts it from the levels simulated (what a
+//!    policy guarantees: the frame rate it holds is set by its slowest frame).
 //! 2. The crowd: one game of many creatures under all rigid, the influence policy and the
 //!    budget policy, every frame timed (can it hold 30 frames a second?).
 
@@ -92,8 +94,7 @@ impl Setting {
     }
 }
 
-const HEADER: &str =
-    "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid";
+const HEADER: &str = "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid,slowest_ms,slowest_ms_all_rigid";
 
 /// One trial under one setting, beside the identical trial all rigid.
 struct Row {
@@ -105,6 +106,9 @@ struct Row {
     mean_rigid: f64,
     wall_s: f64,
     wall_s_all_rigid: f64,
+    /// The trial's slowest frame, as the cost model predicts it from the levels simulated.
+    slowest_ms: f32,
+    slowest_ms_all_rigid: f32,
 }
 
 impl Row {
@@ -152,6 +156,8 @@ fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[
                 mean_rigid: run.levels_mean[Lod::Rigid],
                 wall_s: run.wall_seconds,
                 wall_s_all_rigid: rigid.wall_seconds,
+                slowest_ms: run.predicted_frame.slowest_ms,
+                slowest_ms_all_rigid: rigid.predicted_frame.slowest_ms,
             }
         })
         .collect()
@@ -170,7 +176,28 @@ struct Point {
     /// The standard error of the mean difference.
     se_difference: f64,
     mean_rigid: f64,
+    /// All rigid's wall time over the policy's.
     speedup: f64,
+    /// The trials' slowest frames as the cost model predicts them, on average, and all rigid's
+    /// over it.
+    slowest_ms: f64,
+    slowest_speedup: f64,
+}
+
+/// A speed-up of the trade-off: on average, or of the slowest frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Axis {
+    Mean,
+    Slowest,
+}
+
+impl Axis {
+    fn of(self, p: &Point) -> f64 {
+        match self {
+            Axis::Mean => p.speedup,
+            Axis::Slowest => p.slowest_speedup,
+        }
+    }
 }
 
 /// A budget's point against the fixed-radius curve at the same speed-up.
@@ -199,13 +226,14 @@ fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
     (mean, variance.sqrt(), (variance / values.len() as f64).sqrt())
 }
 
-/// Each budget point that lies within the fixed-radius curve's range of speed-ups, against
-/// that curve at its speed-up (figure 10's axes: the nearer zero the difference, the better).
+/// Each budget point that lies within the fixed-radius curve's range of speed-ups on `axis`,
+/// against that curve at its speed-up (figure 10's axes: the nearer zero the difference, the
+/// better).
 /// Trial by trial, the fixed radii's difference is interpolated between the two radii on either
 /// side, and the gap is how much nearer zero the budget's is, the signs those of the means.
-fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point]) -> Vec<Against> {
+fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) -> Vec<Against> {
     let mut curve: Vec<&Point> = fixed.to_vec();
-    curve.sort_by(|a, b| a.speedup.total_cmp(&b.speedup));
+    curve.sort_by(|a, b| axis.of(a).total_cmp(&axis.of(b)));
     let differences = |setting: Setting| -> Vec<f64> {
         let mut at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
         at.sort_by_key(|r| r.trial);
@@ -214,11 +242,12 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point]) -> Vec<Again
     budget
         .iter()
         .filter_map(|b| {
+            let speedup = axis.of(b);
             let i = curve
                 .windows(2)
-                .position(|w| w[0].speedup <= b.speedup && b.speedup <= w[1].speedup)?;
+                .position(|w| axis.of(w[0]) <= speedup && speedup <= axis.of(w[1]))?;
             let (lo, hi) = (curve[i], curve[i + 1]);
-            let w = (b.speedup / lo.speedup).ln() / (hi.speedup / lo.speedup).ln().max(1e-12);
+            let w = (speedup / axis.of(lo)).ln() / (axis.of(hi) / axis.of(lo)).ln().max(1e-12);
             let at = |f: fn(&Point) -> f64| f(lo) + w * (f(hi) - f(lo));
             let (fixed_difference, fixed_se_difference) = (at(|p| p.mean_difference), at(|p| p.se_difference));
             let (sign_fixed, sign_budget) = (fixed_difference.signum(), b.mean_difference.signum());
@@ -234,7 +263,7 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point]) -> Vec<Again
             let (gap, _, se_gap) = mean_sd_se(&gaps);
             Some(Against {
                 budget_ms: b.setting,
-                speedup: b.speedup,
+                speedup,
                 difference: b.mean_difference,
                 se_difference: b.se_difference,
                 fixed_difference,
@@ -266,6 +295,8 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
                 se_difference,
                 mean_rigid: mean(&|r| r.mean_rigid),
                 speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
+                slowest_ms: mean(&|r| f64::from(r.slowest_ms)),
+                slowest_speedup: mean(&|r| f64::from(r.slowest_ms_all_rigid)) / mean(&|r| f64::from(r.slowest_ms)),
             }
         })
         .collect()
@@ -368,7 +399,7 @@ fn finish(
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4}",
+            "{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4},{:.4},{:.4}",
             r.setting.policy(),
             r.setting.value(),
             r.trial,
@@ -379,17 +410,33 @@ fn finish(
             r.difference(),
             r.mean_rigid,
             r.wall_s,
-            r.wall_s_all_rigid
+            r.wall_s_all_rigid,
+            r.slowest_ms,
+            r.slowest_ms_all_rigid
         );
     }
     let curve = |policy: &str| -> Vec<&Point> { points.iter().filter(|p| p.policy == policy).collect() };
     let (fixed, budget) = (curve("influence"), curve("budget"));
-    let against = against_fixed(rows, &fixed, &budget);
-    let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, p.speedup)).collect::<Vec<_>>();
-    let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
-        ps.iter()
-            .map(|p| (p.mean_difference, p.speedup, format!("  {}{unit}", p.setting)))
-            .collect()
+    let against = against_fixed(rows, &fixed, &budget, Axis::Mean);
+    let against_slowest = against_fixed(rows, &fixed, &budget, Axis::Slowest);
+    let trade_off = |axis: Axis, title: String, y_label: &str| {
+        let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, axis.of(p))).collect::<Vec<_>>();
+        let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
+            ps.iter()
+                .map(|p| (p.mean_difference, axis.of(p), format!("  {}{unit}", p.setting)))
+                .collect()
+        };
+        Panel {
+            title,
+            x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
+            y_label: y_label.into(),
+            series: vec![
+                Series::new("fixed puck radius (figure 10's rule)", trade(&fixed), Mark::Line, 0),
+                Series::new("budget policy", trade(&budget), Mark::Line, 1),
+            ],
+            notes: notes(&fixed, " m").into_iter().chain(notes(&budget, " ms")).collect(),
+            ..Panel::default()
+        }
     };
     let mut trace_series = Vec::new();
     for (i, c) in crowd.iter().enumerate() {
@@ -415,20 +462,19 @@ fn finish(
     ));
     plot::draw(
         &out.join("budget.png"),
-        1400,
+        2000,
         600,
         &[
-            Panel {
-                title: format!("speed against outcome ({} trials of {} s each)", s.trials, s.seconds),
-                x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
-                y_label: "speed-up over all rigid (wall time)".into(),
-                series: vec![
-                    Series::new("fixed puck radius (figure 10's rule)", trade(&fixed), Mark::Line, 0),
-                    Series::new("budget policy", trade(&budget), Mark::Line, 1),
-                ],
-                notes: notes(&fixed, " m").into_iter().chain(notes(&budget, " ms")).collect(),
-                ..Panel::default()
-            },
+            trade_off(
+                Axis::Mean,
+                format!("speed against outcome ({} trials of {} s each)", s.trials, s.seconds),
+                "speed-up over all rigid (wall time, on average)",
+            ),
+            trade_off(
+                Axis::Slowest,
+                "the frame rate guaranteed against outcome".into(),
+                "speed-up of the slowest frame over all rigid's (cost model)",
+            ),
             Panel {
                 title: format!("frame times of a game of {} creatures", s.crowd_creatures),
                 x_label: "simulated time (s)".into(),
@@ -443,15 +489,17 @@ fn finish(
         "The budget policy (issue 14) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
          The difference is the policy's creatures that collided with the puck or a wall minus all rigid's; \
-         the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`).\n\n\
-         | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up |\n|---|---|---|---|---|---|---|\n",
+         the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`); \
+         the slowest frame each trial's slowest as the cost model predicts it from the levels simulated (the court's fixed cost and each creature's level), \
+         and its speed-up all rigid's over the policy's: the frame rate a policy holds is set by its slowest frame.\n\n\
+         | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up | slowest frame (ms, mean) | speed-up of the slowest frame |\n|---|---|---|---|---|---|---|---|---|\n",
         s.trials, s.seconds, s.first_seed, s.fixed_rules, s.budget_rules
     );
     for p in points {
         let unit = if p.policy == "budget" { "ms" } else { "m" };
         let _ = writeln!(
             report,
-            "| {} | {} {unit} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} |",
+            "| {} | {} {unit} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} |",
             p.policy,
             p.setting,
             p.mean_difference,
@@ -459,7 +507,9 @@ fn finish(
             p.mean_abs_difference,
             p.sd_difference,
             p.mean_rigid,
-            p.speedup
+            p.speedup,
+            p.slowest_ms,
+            p.slowest_speedup
         );
     }
     let _ = write!(
@@ -467,23 +517,14 @@ fn finish(
         "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; budgets outside \
          its range of speed-ups are left out). Nearer zero is nearer all rigid's outcome. The gap is how much nearer the budget's \
          is, taken trial by trial: each trial's budget game against its fixed-radius games, so that the all-rigid game's chance \
-         cancels where both differences have the same sign.\n\n\
-         | budget | speed-up | difference +- s.e. | fixed radii at that speed-up | gap +- s.e. (trial by trial) | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|---|\n"
+         cancels where both differences have the same sign. First at the same speed-up on average (figure 10's), then at the \
+         same speed-up of the slowest frame (the frame rate guaranteed).\n"
     );
-    for a in &against {
-        let _ = writeln!(
-            report,
-            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
-            a.budget_ms,
-            a.speedup,
-            a.difference,
-            a.se_difference,
-            a.fixed_difference,
-            a.fixed_se_difference,
-            a.gap,
-            a.se_gap,
-            if a.nearer_beyond_2_se { "yes" } else { "no" }
-        );
+    for (axis, against) in [
+        ("speed-up", &against),
+        ("speed-up of the slowest frame", &against_slowest),
+    ] {
+        against_table(&mut report, axis, against);
     }
     let _ = write!(
         report,
@@ -508,13 +549,37 @@ fn finish(
     .finish(out, &csv)
 }
 
+/// A table of the budgets against the fixed radii at the same `axis`.
+fn against_table(report: &mut String, axis: &str, against: &[Against]) {
+    let _ = write!(
+        report,
+        "\n| budget | {axis} | difference +- s.e. | fixed radii at that {axis} | gap +- s.e. (trial by trial) | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|---|\n"
+    );
+    for a in against {
+        let _ = writeln!(
+            report,
+            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
+            a.budget_ms,
+            a.speedup,
+            a.difference,
+            a.se_difference,
+            a.fixed_difference,
+            a.fixed_se_difference,
+            a.gap,
+            a.se_gap,
+            if a.nearer_beyond_2_se { "yes" } else { "no" }
+        );
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     /// Trials whose all-rigid games collide 0, 10, 0, 10 times; the game at `setting` collides
-    /// `collided` each time, its wall time over all rigid's 8 s giving the speed-up.
-    fn trials(setting: Setting, collided: u64, wall_s: f64) -> Vec<Row> {
+    /// `collided` each time, its wall time over all rigid's 8 s giving the speed-up, and its
+    /// slowest frame over all rigid's 8 ms giving the slowest frame's, `slowdown` times it.
+    fn trials(setting: Setting, collided: u64, wall_s: f64, slowdown: f64) -> Vec<Row> {
         (0..4)
             .map(|trial| Row {
                 setting,
@@ -525,6 +590,8 @@ mod tests {
                 mean_rigid: 0.0,
                 wall_s,
                 wall_s_all_rigid: 8.0,
+                slowest_ms: (wall_s * slowdown) as f32,
+                slowest_ms_all_rigid: 8.0,
             })
             .collect()
     }
@@ -539,16 +606,23 @@ mod tests {
             Setting::Budget(0.5),
         ];
         // Speed-ups 2 and 8; the budgets at 4 (halfway in log speed-up), 4 and 16 (past the
-        // curve's end).
-        let rows: Vec<Row> = [(2, 4.0), (2, 1.0), (3, 2.0), (14, 2.0), (3, 0.5)]
-            .into_iter()
-            .zip(settings)
-            .flat_map(|((collided, wall_s), setting)| trials(setting, collided, wall_s))
-            .collect();
+        // curve's end). Of the slowest frame: 1 and 4; the budgets at 4 (the curve's end), 4
+        // and, the last one's slowest frame dear, 2.
+        let rows: Vec<Row> = [
+            (2, 4.0, 2.0),
+            (2, 1.0, 2.0),
+            (3, 2.0, 1.0),
+            (14, 2.0, 1.0),
+            (3, 0.5, 8.0),
+        ]
+        .into_iter()
+        .zip(settings)
+        .flat_map(|((collided, wall_s, slowdown), setting)| trials(setting, collided, wall_s, slowdown))
+        .collect();
         let points = summarise(&rows, &settings);
         let [fixed, budget] =
             ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
-        let against = against_fixed(&rows, &fixed, &budget);
+        let against = against_fixed(&rows, &fixed, &budget, Axis::Mean);
         assert_eq!(against.len(), 2, "{against:?}");
         // Differences of -3 and -2 on average, each with a standard error of 2.9 from the
         // all-rigid games alone; trial by trial the budget is 1 nearer every time.
@@ -561,5 +635,10 @@ mod tests {
         // +9 against -3: farther.
         assert!((two_ms.gap + 6.0).abs() < 1e-9, "{two_ms:?}");
         assert!(!two_ms.nearer_beyond_2_se);
+        // Of the slowest frame, the half-millisecond budget falls within the curve too.
+        let slowest = against_fixed(&rows, &fixed, &budget, Axis::Slowest);
+        let budgets: Vec<f32> = slowest.iter().map(|a| a.budget_ms).collect();
+        assert_eq!(budgets, [1.0, 2.0, 0.5]);
+        assert!((slowest[2].speedup - 2.0).abs() < 1e-6 && (slowest[2].gap - 1.0).abs() < 1e-9);
     }
 }

@@ -93,10 +93,11 @@ struct Step {
 
 /// Chooses a level for each candidate: from each one's floor, the steps up with the most
 /// benefit per microsecond first, while the budget allows (a multiple-choice knapsack solved
-/// greedily on each creature's upper convex hull of cost and benefit). Then, since a creature
+/// greedily on each creature's upper convex hull of cost and benefit); a step that gains less
+/// than `least_per_us` per microsecond is never taken, so the budget is a ceiling. Then, since a creature
 /// going down keeps costing its old level until its flight window, the last steps taken are
 /// given back until the frame as it will run fits. Deterministic: ties go to the lower serial.
-pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32) -> Allocation {
+pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32, least_per_us: f32) -> Allocation {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
     let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
     let mut steps = Vec::new();
@@ -115,7 +116,9 @@ pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32) -> Al
                     (if extra > 0.0 { gain / extra } else { f32::INFINITY }, l, extra)
                 })
                 .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
-            let Some((ratio, to, extra_us)) = best else { break };
+            let Some((ratio, to, extra_us)) = best.filter(|b| b.0 >= least_per_us) else {
+                break;
+            };
             steps.push(Step {
                 ratio,
                 creature: i,
@@ -400,7 +403,13 @@ fn decide(
         .collect();
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let overhead_us = config.costs.overhead_us(candidates.len());
-    let mut allocation = allocate(&candidates, budget_us - overhead_us, config.rules.budget.hysteresis);
+    let rules = &config.rules.budget;
+    let mut allocation = allocate(
+        &candidates,
+        budget_us - overhead_us,
+        rules.hysteresis,
+        rules.least_benefit_per_ms / 1e3,
+    );
     allocation.predicted_us += overhead_us;
     (rows.iter().map(|r| r.0).collect(), allocation)
 }
@@ -559,7 +568,7 @@ mod tests {
     fn the_budget_goes_to_the_most_benefit_per_cost_and_is_never_exceeded() {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Room for two going rigid and three hybrids (2 x (100 + 50) + 3 x 2 = 306).
-        let a = allocate(&cs, 310.0, 0.0);
+        let a = allocate(&cs, 310.0, 0.0, 0.0);
         assert_eq!(
             a.levels,
             [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]
@@ -568,11 +577,26 @@ mod tests {
     }
 
     #[test]
+    fn a_level_that_gains_less_than_the_least_benefit_per_cost_is_not_bought_however_large_the_budget() {
+        let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
+        // Going rigid from hybrid gains i - 0.5 for 148 us; at 0.02 per us only i = 4 pays.
+        let a = allocate(&cs, 10_000.0, 0.0, 0.02);
+        assert_eq!(
+            a.levels,
+            [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid]
+        );
+        assert!(
+            (a.predicted_us - (4.0 * 2.0 + 150.0)).abs() < 1e-3 && !a.exceeded,
+            "{a:?}"
+        );
+    }
+
+    #[test]
     fn a_creature_going_down_still_counts_until_it_switches() {
         // One rigid now, with no benefit left; one hybrid with a contact ahead. Going down in
         // the flight window, the first still costs its rigid level this frame: no room yet.
         let cs = [candidate(0, Lod::Rigid, 0.0), candidate(1, Lod::Hybrid, 5.0)];
-        let a = allocate(&cs, 160.0, 0.0);
+        let a = allocate(&cs, 160.0, 0.0, 0.0);
         assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid]);
         assert!(a.predicted_us <= 160.0, "{a:?}");
     }
@@ -595,7 +619,7 @@ mod tests {
     #[test]
     fn too_small_a_budget_gives_the_cheapest_levels_and_says_so() {
         let cs: Vec<_> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
-        let a = allocate(&cs, 1.0, 0.0);
+        let a = allocate(&cs, 1.0, 0.0, 0.0);
         assert_eq!(a.levels, [Lod::PointMass; 3]);
         assert!(a.exceeded);
     }

@@ -39,6 +39,11 @@ pub struct SwitchTally {
     pub level_sums: Counts<Lod, u64>,
     pub level_peaks: Counts<Lod, u64>,
     pub samples: u64,
+    /// The cost model's prediction of each sampled frame from the levels simulated in it (the
+    /// fixed cost and each creature's level; not the policy's own choice): its sum and the
+    /// slowest, in microseconds. Every policy's, so they compare on what they guarantee.
+    pub predicted_frame_sum_us: f64,
+    pub predicted_frame_max_us: f32,
 }
 
 fn switch_levels(
@@ -118,16 +123,27 @@ fn switch_levels(
     }
 }
 
-/// Samples the creatures per level at each decision.
-fn count_levels(clock: Res<SimClock>, mut tally: ResMut<SwitchTally>, levels: Query<&Lod>) {
+/// Samples the creatures per level at each decision, and what the cost model predicts the
+/// frame costs.
+fn count_levels(
+    clock: Res<SimClock>,
+    config: Res<crate::config::SimConfig>,
+    mut tally: ResMut<SwitchTally>,
+    levels: Query<(&Lod, &Creature)>,
+) {
     if !clock.is_decision_tick() {
         return;
     }
+    let costs: Vec<_> = config.kinds.iter().map(|k| config.costs.of(&k.name)).collect();
     let mut counts: Counts<Lod, u64> = Counts::default();
-    for &lod in &levels {
+    let mut frame_us = config.costs.fixed_us_per_frame;
+    for (&lod, c) in &levels {
         counts[lod] += 1;
+        frame_us += costs[c.kind].per_frame_us(lod);
     }
     tally.samples += 1;
+    tally.predicted_frame_sum_us += f64::from(frame_us);
+    tally.predicted_frame_max_us = tally.predicted_frame_max_us.max(frame_us);
     for (lod, n) in counts.iter() {
         tally.level_sums[lod] += n;
         tally.level_peaks[lod] = tally.level_peaks[lod].max(n);

@@ -360,6 +360,14 @@ pub(crate) fn advance_clock(mut clock: ResMut<SimClock>) {
     clock.tick += 1;
 }
 
+/// Milliseconds of simulation per 1/30 s, as the cost model predicts them from the levels
+/// simulated (the court's fixed cost and each creature's level).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PredictedFrame {
+    pub mean_ms: f64,
+    pub slowest_ms: f32,
+}
+
 /// What a run did, as the command line prints it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
@@ -383,6 +391,9 @@ pub struct Summary {
     /// Creatures at each level, averaged over the run's steering decisions, and the peak.
     pub levels_mean: Counts<Lod, f64>,
     pub levels_peak: Counts<Lod, u64>,
+    /// The cost model's prediction of a frame from the levels simulated in it, whatever the
+    /// policy: on average and the slowest.
+    pub predicted_frame: PredictedFrame,
     /// The pops of the switches in what is drawn, by kind of switch (from, to, forced by a
     /// collision or not): the largest and the 95th percentile.
     pub pops: Vec<PopSummary>,
@@ -424,6 +435,10 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         switches: switching.switches,
         levels_mean: Counts::from_fn(|l| switching.level_sums[l] as f64 / samples),
         levels_peak: switching.level_peaks,
+        predicted_frame: PredictedFrame {
+            mean_ms: switching.predicted_frame_sum_us / samples / 1e3,
+            slowest_ms: switching.predicted_frame_max_us / 1e3,
+        },
         pops,
         budget,
         seed,

@@ -65,9 +65,51 @@ fn the_predicted_cost_never_exceeds_the_budget() {
     }
     // The budget is spent, not hoarded: some creatures were rigid.
     assert!(rigid_seen >= 3, "at most {rigid_seen} rigid");
-    let summary = sim.summary(0.0).budget.expect("a budget summary");
-    assert_eq!(summary.decisions_over_budget, 0);
-    assert!(summary.predicted_ms_max <= budget_ms);
+    let summary = sim.summary(0.0);
+    // The slowest frame, predicted from the levels simulated, is the frame rate guaranteed.
+    assert!(
+        summary.predicted_frame.slowest_ms <= budget_ms,
+        "{:?}",
+        summary.predicted_frame
+    );
+    let budget = summary.budget.expect("a budget summary");
+    assert_eq!(budget.decisions_over_budget, 0);
+    assert!(budget.predicted_ms_max <= budget_ms);
+}
+
+#[test]
+fn every_policy_reports_its_frames_as_the_cost_model_predicts_them_from_the_levels() {
+    // 10 hoppers, a court costing 30 us: 1.03 ms all rigid, 0.04 ms all point masses.
+    for (policy, frame_ms) in [(LevelPolicy::AllRigid, 1.03), (LevelPolicy::AllPointMass, 0.04)] {
+        let mut config = budget_scene(10, 0.0);
+        config.scenario.level_policy = policy;
+        config.costs.fixed_us_per_frame = 30.0;
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(2.0);
+        let frame = sim.summary(0.0).predicted_frame;
+        assert!(
+            (frame.mean_ms - frame_ms).abs() < 1e-6 && (f64::from(frame.slowest_ms) - frame_ms).abs() < 1e-6,
+            "{policy:?}: {frame:?}"
+        );
+    }
+}
+
+#[test]
+fn with_a_least_benefit_per_cost_the_budget_is_a_ceiling_not_a_target() {
+    // Room for all 20 hoppers rigid: spent on all of them with no least benefit, on only the
+    // few near a contact with one.
+    let rigid_on_average = |least_benefit_per_ms: f32| {
+        let mut config = budget_scene(20, 100.0);
+        config.rules.budget.least_benefit_per_ms = least_benefit_per_ms;
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(10.0);
+        let summary = sim.summary(0.0);
+        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
+        summary.levels_mean[Lod::Rigid]
+    };
+    let (all, some) = (rigid_on_average(0.0), rigid_on_average(5.0));
+    assert!(all > 19.0, "{all} rigid on average with no least benefit");
+    assert!(some > 0.0 && some < 10.0, "{some} rigid on average at 5 per ms");
 }
 
 #[test]
