@@ -107,8 +107,8 @@ struct Row {
     wall_s: f64,
     wall_s_all_rigid: f64,
     /// The trial's slowest frame, as the cost model predicts it from the levels simulated.
-    slowest_ms: f32,
-    slowest_ms_all_rigid: f32,
+    slowest_ms: f64,
+    slowest_ms_all_rigid: f64,
 }
 
 impl Row {
@@ -295,8 +295,8 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
                 se_difference,
                 mean_rigid: mean(&|r| r.mean_rigid),
                 speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
-                slowest_ms: mean(&|r| f64::from(r.slowest_ms)),
-                slowest_speedup: mean(&|r| f64::from(r.slowest_ms_all_rigid)) / mean(&|r| f64::from(r.slowest_ms)),
+                slowest_ms: mean(&|r| r.slowest_ms),
+                slowest_speedup: mean(&|r| r.slowest_ms_all_rigid) / mean(&|r| r.slowest_ms),
             }
         })
         .collect()
@@ -590,7 +590,7 @@ mod tests {
                 mean_rigid: 0.0,
                 wall_s,
                 wall_s_all_rigid: 8.0,
-                slowest_ms: (wall_s * slowdown) as f32,
+                slowest_ms: wall_s * slowdown,
                 slowest_ms_all_rigid: 8.0,
             })
             .collect()

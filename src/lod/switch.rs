@@ -42,8 +42,9 @@ pub struct SwitchTally {
     /// The cost model's prediction of each sampled frame from the levels simulated in it (the
     /// fixed cost and each creature's level; not the policy's own choice): its sum and the
     /// slowest, in microseconds. Every policy's, so they compare on what they guarantee.
+    /// (Summed in f64, where the f32 costs add exactly: the same whatever the creatures' order.)
     pub predicted_frame_sum_us: f64,
-    pub predicted_frame_max_us: f32,
+    pub predicted_frame_max_us: f64,
 }
 
 fn switch_levels(
@@ -136,13 +137,13 @@ fn count_levels(
     }
     let costs: Vec<_> = config.kinds.iter().map(|k| config.costs.of(&k.name)).collect();
     let mut counts: Counts<Lod, u64> = Counts::default();
-    let mut frame_us = config.costs.fixed_us_per_frame;
+    let mut frame_us = f64::from(config.costs.fixed_us_per_frame);
     for (&lod, c) in &levels {
         counts[lod] += 1;
-        frame_us += costs[c.kind].per_frame_us(lod);
+        frame_us += f64::from(costs[c.kind].per_frame_us(lod));
     }
     tally.samples += 1;
-    tally.predicted_frame_sum_us += f64::from(frame_us);
+    tally.predicted_frame_sum_us += frame_us;
     tally.predicted_frame_max_us = tally.predicted_frame_max_us.max(frame_us);
     for (lod, n) in counts.iter() {
         tally.level_sums[lod] += n;

@@ -365,7 +365,7 @@ pub(crate) fn advance_clock(mut clock: ResMut<SimClock>) {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PredictedFrame {
     pub mean_ms: f64,
-    pub slowest_ms: f32,
+    pub slowest_ms: f64,
 }
 
 /// What a run did, as the command line prints it.

@@ -68,7 +68,7 @@ fn the_predicted_cost_never_exceeds_the_budget() {
     let summary = sim.summary(0.0);
     // The slowest frame, predicted from the levels simulated, is the frame rate guaranteed.
     assert!(
-        summary.predicted_frame.slowest_ms <= budget_ms,
+        summary.predicted_frame.slowest_ms <= f64::from(budget_ms),
         "{:?}",
         summary.predicted_frame
     );
@@ -88,7 +88,7 @@ fn every_policy_reports_its_frames_as_the_cost_model_predicts_them_from_the_leve
         sim.run_for(2.0);
         let frame = sim.summary(0.0).predicted_frame;
         assert!(
-            (frame.mean_ms - frame_ms).abs() < 1e-6 && (f64::from(frame.slowest_ms) - frame_ms).abs() < 1e-6,
+            (frame.mean_ms - frame_ms).abs() < 1e-6 && (frame.slowest_ms - frame_ms).abs() < 1e-6,
             "{policy:?}: {frame:?}"
         );
     }
