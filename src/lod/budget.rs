@@ -94,9 +94,10 @@ struct Step {
 /// Chooses a level for each candidate: from each one's floor, the steps up with the most
 /// benefit per microsecond first, while the budget allows (a multiple-choice knapsack solved
 /// greedily on each creature's upper convex hull of cost and benefit); a step that gains less
-/// than `least_per_us` per microsecond is never taken, so the budget is a ceiling. Then, since a creature
-/// going down keeps costing its old level until its flight window, the last steps taken are
-/// given back until the frame as it will run fits. Deterministic: ties go to the lower serial.
+/// than `least_per_us` per microsecond is never taken, so the budget is a ceiling. Then, since
+/// a creature going down keeps costing its old level until its flight window, the last steps
+/// taken are given back until the frame as it will run fits. Deterministic: ties go to the
+/// lower serial.
 pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32, least_per_us: f32) -> Allocation {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
     let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
