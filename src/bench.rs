@@ -279,13 +279,12 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
     let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
     let kinds = KindTable::of(config);
+    // The median frame in microseconds of `count` creatures of `config` all under `policy`.
+    let frame_us = |config: &SimConfig, count: u32, policy: LevelPolicy, runs: usize, frames: usize| {
+        median_of_runs(&scaled(config, count, policy), runs, warmup, frames) * 1e6
+    };
     // Cheap to measure and in every other figure: many frames, many runs.
-    let fixed_us = median_of_runs(
-        &scaled(config, 0, LevelPolicy::AllPointMass),
-        3 * runs,
-        warmup,
-        5 * frames,
-    ) * 1e6;
+    let fixed_us = frame_us(config, 0, LevelPolicy::AllPointMass, 3 * runs, 5 * frames);
     let mut entries = Vec::new();
     for def in &config.kinds {
         let alone = crate::experiments::only_kind(config, &def.name);
@@ -297,8 +296,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
                 Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
-            let frame_s = median_of_runs(&scaled(&alone, count, policy), runs, warmup, frames);
-            us[level as usize] = (frame_s * 1e6 - fixed_us).max(0.0) / f64::from(count);
+            us[level as usize] = (frame_us(&alone, count, policy, runs, frames) - fixed_us).max(0.0) / f64::from(count);
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -343,20 +341,9 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     // same crowd all point masses.
     let mut choosing = config.clone();
     (choosing.costs, choosing.rules.budget.frame_budget_ms) = (model.clone(), 0.0);
-    let choosing_us = median_of_runs(
-        &scaled(&choosing, cheap_count, LevelPolicy::Budget),
-        runs,
-        warmup,
-        frames,
-    ) * 1e6;
-    let decision_us = (choosing_us
-        - median_of_runs(
-            &scaled(config, cheap_count, LevelPolicy::AllPointMass),
-            runs,
-            warmup,
-            frames,
-        ) * 1e6)
-        .max(0.0)
+    let decision_us = (frame_us(&choosing, cheap_count, LevelPolicy::Budget, runs, frames)
+        - frame_us(config, cheap_count, LevelPolicy::AllPointMass, runs, frames))
+    .max(0.0)
         / f64::from(cheap_count);
     model.decision_us_per_creature = decision_us as f32;
     model

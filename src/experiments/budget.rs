@@ -25,8 +25,8 @@ use crate::lod::{LevelPolicy, Lod};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BudgetSettings {
-    /// The frame budgets the budget policy runs at, ms of simulation per 1/30 s.
-    pub budgets_ms: Vec<f32>,
+    /// The budget policy's settings: each a frame budget, as a target or as a ceiling.
+    pub budgets: Vec<BudgetPoint>,
     /// The puck radii the fixed-radius curve runs at, under `fixed_rules`.
     pub radii_m: Vec<f32>,
     /// The level rules of the fixed-radius curve (figure 10's: the puck's area only).
@@ -47,13 +47,20 @@ pub struct BudgetSettings {
 
 impl Validate for BudgetSettings {
     fn validate(&self, v: &mut Validator) {
-        v.require(
-            !self.budgets_ms.is_empty(),
-            "budgets_ms",
-            "must list at least one budget",
-        );
-        for (i, b) in self.budgets_ms.iter().enumerate() {
-            v.range(&format!("budgets_ms[{i}]"), *b, 0.0, 10_000.0);
+        v.require(!self.budgets.is_empty(), "budgets", "must list at least one budget");
+        for (i, b) in self.budgets.iter().enumerate() {
+            v.range(
+                &format!("budgets[{i}].frame_budget_ms"),
+                b.frame_budget_ms,
+                0.0,
+                10_000.0,
+            );
+            v.range(
+                &format!("budgets[{i}].least_benefit_per_ms"),
+                b.least_benefit_per_ms,
+                0.0,
+                1e6,
+            );
         }
         v.require(!self.radii_m.is_empty(), "radii_m", "must list at least one radius");
         for (i, r) in self.radii_m.iter().enumerate() {
@@ -73,11 +80,23 @@ impl Validate for BudgetSettings {
     }
 }
 
+/// One setting of the budget policy: a frame budget (ms of simulation per 1/30 s), and the
+/// least benefit per ms a level must bring to be bought (the budget rules'
+/// `least_benefit_per_ms`): at 0 the budget is a target, spent whenever anything gains; above,
+/// a ceiling, spent only where a contact is near, in bursts as a radius spends.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetPoint {
+    pub frame_budget_ms: f32,
+    #[serde(default)]
+    pub least_benefit_per_ms: f32,
+}
+
 /// One policy's setting in the trade-off: a fixed radius or a frame budget.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Setting {
     Radius(f32),
-    Budget(f32),
+    Budget(BudgetPoint),
 }
 
 impl Setting {
@@ -88,14 +107,34 @@ impl Setting {
         }
     }
 
+    /// The radius (m) or the frame budget (ms).
     fn value(self) -> f32 {
         match self {
-            Setting::Radius(r) | Setting::Budget(r) => r,
+            Setting::Radius(r) => r,
+            Setting::Budget(b) => b.frame_budget_ms,
+        }
+    }
+
+    fn least_benefit_per_ms(self) -> f32 {
+        match self {
+            Setting::Radius(_) => 0.0,
+            Setting::Budget(b) => b.least_benefit_per_ms,
+        }
+    }
+
+    /// As the report and the plot name it.
+    fn label(self) -> String {
+        match self {
+            Setting::Radius(r) => format!("{r} m"),
+            Setting::Budget(b) if b.least_benefit_per_ms > 0.0 => {
+                format!("{} ms from {}/ms", b.frame_budget_ms, b.least_benefit_per_ms)
+            }
+            Setting::Budget(b) => format!("{} ms", b.frame_budget_ms),
         }
     }
 }
 
-const HEADER: &str = "policy,setting,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid,slowest_ms,slowest_ms_all_rigid,p99_ms,p99_ms_all_rigid";
+const HEADER: &str = "policy,setting,least_benefit_per_ms,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid,slowest_ms,slowest_ms_all_rigid,p99_ms,p99_ms_all_rigid";
 
 /// One trial under one setting, beside the identical trial all rigid.
 struct Row {
@@ -146,7 +185,8 @@ fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[
                 }
                 Setting::Budget(b) => {
                     (c.rules, c.costs) = rules.budget.clone();
-                    c.rules.budget.frame_budget_ms = b;
+                    c.rules.budget.frame_budget_ms = b.frame_budget_ms;
+                    c.rules.budget.least_benefit_per_ms = b.least_benefit_per_ms;
                     c.scenario.level_policy = LevelPolicy::Budget;
                 }
             }
@@ -180,8 +220,11 @@ fn p99_ms(frames_s: &[f64]) -> f64 {
 /// Figures per setting.
 #[derive(Clone, Debug, Serialize)]
 struct Point {
+    #[serde(skip)]
+    of: Setting,
     policy: &'static str,
     setting: f32,
+    least_benefit_per_ms: f32,
     trials: usize,
     mean_difference: f64,
     /// The mean of each trial's difference, without its sign: how far a trial's outcome moves.
@@ -262,11 +305,15 @@ impl Axis {
 #[derive(Clone, Debug, Serialize)]
 struct Against {
     budget_ms: f32,
+    least_benefit_per_ms: f32,
+    #[serde(skip)]
+    label: String,
     speedup: f64,
     difference: f64,
     se_difference: f64,
     /// The fixed-radius curve's mean difference and standard error at this speed-up,
-    /// interpolated in log speed-up between the radii on either side.
+    /// interpolated in log speed-up between the radii on either side; beyond the fastest
+    /// radius, the fastest radius's (slower than the budget: no radius reaches its speed-up).
     fixed_difference: f64,
     fixed_se_difference: f64,
     /// How much nearer all rigid's outcome the budget's is than the fixed radii's (negative:
@@ -276,6 +323,8 @@ struct Against {
     se_gap: f64,
     /// The gap is over two of its standard errors.
     nearer_beyond_2_se: bool,
+    /// Faster than every radius: set against the fastest.
+    beyond_fastest_radius: bool,
 }
 
 /// Mean, standard deviation and standard error of the mean.
@@ -284,9 +333,10 @@ fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
     (mean, variance.sqrt(), (variance / values.len() as f64).sqrt())
 }
 
-/// Each budget point that lies within the fixed-radius curve's range of speed-ups on `axis`,
-/// against that curve at its speed-up (figure 10's axes: the nearer zero the difference, the
-/// better).
+/// Each budget point that lies within the fixed-radius curve's range of speed-ups on `axis`, or
+/// beyond its fastest end, against that curve at its speed-up (figure 10's axes: the nearer
+/// zero the difference, the better); beyond the fastest radius, against the fastest radius,
+/// which is slower. Budgets slower than every radius are left out.
 /// Trial by trial, the fixed radii's difference is interpolated between the two radii on either
 /// side, and the gap is how much nearer zero the budget's is, the signs those of the means.
 fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) -> Vec<Against> {
@@ -297,23 +347,30 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) 
         at.sort_by_key(|r| r.trial);
         at.iter().map(|r| r.difference()).collect()
     };
+    let Some(&fastest) = curve.last() else {
+        return Vec::new();
+    };
     budget
         .iter()
         .filter_map(|b| {
             let speedup = axis.of(b);
-            let i = curve
+            let (lo, hi, w, beyond) = match curve
                 .windows(2)
-                .position(|w| axis.of(w[0]) <= speedup && speedup <= axis.of(w[1]))?;
-            let (lo, hi) = (curve[i], curve[i + 1]);
-            let w = (speedup / axis.of(lo)).ln() / (axis.of(hi) / axis.of(lo)).ln().max(1e-12);
+                .position(|w| axis.of(w[0]) <= speedup && speedup <= axis.of(w[1]))
+            {
+                Some(i) => {
+                    let (lo, hi) = (curve[i], curve[i + 1]);
+                    let w = (speedup / axis.of(lo)).ln() / (axis.of(hi) / axis.of(lo)).ln().max(1e-12);
+                    (lo, hi, w, false)
+                }
+                None if speedup > axis.of(fastest) => (fastest, fastest, 0.0, true),
+                None => return None,
+            };
             let at = |f: fn(&Point) -> f64| f(lo) + w * (f(hi) - f(lo));
             let (fixed_difference, fixed_se_difference) = (at(|p| p.mean_difference), at(|p| p.se_difference));
             let (sign_fixed, sign_budget) = (fixed_difference.signum(), b.mean_difference.signum());
-            let (d_lo, d_hi) = (
-                differences(Setting::Radius(lo.setting)),
-                differences(Setting::Radius(hi.setting)),
-            );
-            let gaps: Vec<f64> = differences(Setting::Budget(b.setting))
+            let (d_lo, d_hi) = (differences(lo.of), differences(hi.of));
+            let gaps: Vec<f64> = differences(b.of)
                 .iter()
                 .zip(d_lo.iter().zip(&d_hi))
                 .map(|(d_b, (d_lo, d_hi))| sign_fixed * (d_lo + w * (d_hi - d_lo)) - sign_budget * d_b)
@@ -321,6 +378,8 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) 
             let (gap, _, se_gap) = mean_sd_se(&gaps);
             Some(Against {
                 budget_ms: b.setting,
+                least_benefit_per_ms: b.least_benefit_per_ms,
+                label: b.of.label(),
                 speedup,
                 difference: b.mean_difference,
                 se_difference: b.se_difference,
@@ -329,6 +388,7 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) 
                 gap,
                 se_gap,
                 nearer_beyond_2_se: gap > 2.0 * se_gap,
+                beyond_fastest_radius: beyond,
             })
         })
         .collect()
@@ -344,8 +404,10 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
             let (mean_difference, sd_difference, se_difference) =
                 mean_sd_se(&at.iter().map(|r| r.difference()).collect::<Vec<_>>());
             Point {
+                of: setting,
                 policy: setting.policy(),
                 setting: setting.value(),
+                least_benefit_per_ms: setting.least_benefit_per_ms(),
                 trials: at.len(),
                 mean_difference,
                 mean_abs_difference: mean(&|r| r.difference().abs()),
@@ -426,7 +488,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         .radii_m
         .iter()
         .map(|&r| Setting::Radius(r))
-        .chain(s.budgets_ms.iter().map(|&b| Setting::Budget(b)))
+        .chain(s.budgets.iter().map(|&b| Setting::Budget(b)))
         .collect();
     let todo: Vec<u32> = (0..s.trials).collect();
     let mut rows = Vec::new();
@@ -459,9 +521,10 @@ fn finish(
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+            "{},{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
             r.setting.policy(),
             r.setting.value(),
+            r.setting.least_benefit_per_ms(),
             r.trial,
             r.seed,
             s.seconds,
@@ -480,23 +543,33 @@ fn finish(
     let curve = |policy: &str| -> Vec<&Point> { points.iter().filter(|p| p.policy == policy).collect() };
     let (fixed, budget) = (curve("influence"), curve("budget"));
     let against = Axis::ALL.map(|axis| (axis, against_fixed(rows, &fixed, &budget, axis)));
+    let (ceilings, targets): (Vec<&Point>, Vec<&Point>) = budget.iter().partition(|p| p.least_benefit_per_ms > 0.0);
     let trade_off = |axis: Axis| {
         let (title, y_label) = axis.panel();
         let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, axis.of(p))).collect::<Vec<_>>();
-        let notes = |ps: &[&Point], unit: &str| -> Vec<(f64, f64, String)> {
-            ps.iter()
-                .map(|p| (p.mean_difference, axis.of(p), format!("  {}{unit}", p.setting)))
-                .collect()
-        };
+        let notes = fixed
+            .iter()
+            .chain(&budget)
+            .map(|p| (p.mean_difference, axis.of(p), format!("  {}", p.of.label())))
+            .collect();
         Panel {
-            title: title.into(),
+            title: format!("{title} ({} trials of {} s each)", s.trials, s.seconds),
             x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
             y_label: y_label.into(),
-            series: vec![
-                Series::new("fixed puck radius (figure 10's rule)", trade(&fixed), Mark::Line, 0),
-                Series::new("budget policy", trade(&budget), Mark::Line, 1),
-            ],
-            notes: notes(&fixed, " m").into_iter().chain(notes(&budget, " ms")).collect(),
+            series: [
+                ("fixed puck radius (figure 10's rule)", &fixed, 0),
+                ("budget policy, the budget a target", &targets, 1),
+                (
+                    "budget policy, a ceiling: bought from a least benefit per ms",
+                    &ceilings,
+                    2,
+                ),
+            ]
+            .into_iter()
+            .filter(|(_, ps, _)| !ps.is_empty())
+            .map(|(label, ps, colour)| Series::new(label, trade(ps), Mark::Line, colour))
+            .collect(),
+            notes,
             ..Panel::default()
         }
     };
@@ -542,18 +615,17 @@ fn finish(
          the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`); \
          the slowest frame each trial's slowest as the cost model predicts it from the levels simulated (the court's fixed cost and each creature's level), \
          and its speed-up all rigid's over the policy's: the frame rate a policy holds is set by its slowest frame; \
-         the 99th-percentile frame each trial's measured wall times' (all but its 6 slowest frames of 600: the first, which builds the world, and the machine's hiccups), \
+         the 99th-percentile frame each trial's measured wall times' (all but its slowest hundredth of frames, 6 of a 20 s trial's 600: the first, which builds the world, and the machine's hiccups), \
          and its speed-up likewise.\n\n\
          | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up | slowest frame (ms, cost model) | its speed-up | 99th-percentile frame (ms, measured) | its speed-up |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
         s.trials, s.seconds, s.first_seed, s.fixed_rules, s.budget_rules
     );
     for p in points {
-        let unit = if p.policy == "budget" { "ms" } else { "m" };
         let _ = writeln!(
             report,
-            "| {} | {} {unit} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            "| {} | {} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
             p.policy,
-            p.setting,
+            p.of.label(),
             p.mean_difference,
             p.se_difference,
             p.mean_abs_difference,
@@ -568,8 +640,8 @@ fn finish(
     }
     let _ = write!(
         report,
-        "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; budgets outside \
-         its range of speed-ups are left out). Nearer zero is nearer all rigid's outcome. The gap is how much nearer the budget's \
+        "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; a budget faster \
+         than every radius against the fastest radius, which is slower; one slower than every radius left out). Nearer zero is nearer all rigid's outcome. The gap is how much nearer the budget's \
          is, taken trial by trial: each trial's budget game against its fixed-radius games, so that the all-rigid game's chance \
          cancels where both differences have the same sign. First at the same speed-up on average (figure 10's), then at the \
          same speed-up of the slowest frame (the frame rate guaranteed), then of the 99th-percentile frame measured.\n"
@@ -615,13 +687,18 @@ fn against_table(report: &mut String, axis: &str, against: &[Against]) {
     for a in against {
         let _ = writeln!(
             report,
-            "| {} ms | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
-            a.budget_ms,
+            "| {} | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2}{} | {:+.2} +- {:.2} | {} |",
+            a.label,
             a.speedup,
             a.difference,
             a.se_difference,
             a.fixed_difference,
             a.fixed_se_difference,
+            if a.beyond_fastest_radius {
+                " (the fastest radius, slower)"
+            } else {
+                ""
+            },
             a.gap,
             a.se_gap,
             if a.nearer_beyond_2_se { "yes" } else { "no" }
@@ -657,22 +734,30 @@ mod tests {
 
     #[test]
     fn a_budget_is_weighed_against_the_fixed_radii_at_its_speedup_trial_by_trial() {
+        let budget = |frame_budget_ms, least_benefit_per_ms| {
+            Setting::Budget(BudgetPoint {
+                frame_budget_ms,
+                least_benefit_per_ms,
+            })
+        };
         let settings = [
             Setting::Radius(8.0),
             Setting::Radius(0.0),
-            Setting::Budget(1.0),
-            Setting::Budget(2.0),
-            Setting::Budget(0.5),
+            budget(1.0, 0.0),
+            budget(2.0, 0.0),
+            budget(0.5, 0.0),
+            budget(4.0, 3.0),
         ];
-        // Speed-ups 2 and 8; the budgets at 4 (halfway in log speed-up), 4 and 16 (past the
-        // curve's end). Of the slowest frame: 1 and 4; the budgets at 4 (the curve's end), 4
-        // and, the last one's slowest frame dear, 2.
+        // Speed-ups 2 and 8; the budgets at 4 (halfway in log speed-up), 4, 16 (past the
+        // fastest radius) and 1 (slower than every radius). Of the slowest frame: 1 and 4; the
+        // budgets at 4 (the curve's end), 4, 2 (the third one's slowest frame dear) and 0.5.
         let rows: Vec<Row> = [
             (2, 4.0, 2.0),
             (2, 1.0, 2.0),
             (3, 2.0, 1.0),
             (14, 2.0, 1.0),
             (3, 0.5, 8.0),
+            (5, 8.0, 2.0),
         ]
         .into_iter()
         .zip(settings)
@@ -682,7 +767,8 @@ mod tests {
         let [fixed, budget] =
             ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
         let against = against_fixed(&rows, &fixed, &budget, Axis::Mean);
-        assert_eq!(against.len(), 2, "{against:?}");
+        let labels: Vec<&str> = against.iter().map(|a| a.label.as_str()).collect();
+        assert_eq!(labels, ["1 ms", "2 ms", "0.5 ms"], "{against:?}");
         // Differences of -3 and -2 on average, each with a standard error of 2.9 from the
         // all-rigid games alone; trial by trial the budget is 1 nearer every time.
         let (one_ms, two_ms) = (&against[0], &against[1]);
@@ -693,7 +779,14 @@ mod tests {
         assert!(one_ms.nearer_beyond_2_se);
         // +9 against -3: farther.
         assert!((two_ms.gap + 6.0).abs() < 1e-9, "{two_ms:?}");
-        assert!(!two_ms.nearer_beyond_2_se);
+        assert!(!two_ms.nearer_beyond_2_se && !two_ms.beyond_fastest_radius);
+        // Faster than every radius, against the fastest (0 m, -3): 1 nearer every time.
+        let fastest = &against[2];
+        assert!(fastest.beyond_fastest_radius && (fastest.fixed_difference + 3.0).abs() < 1e-9);
+        assert!(
+            (fastest.gap - 1.0).abs() < 1e-9 && fastest.nearer_beyond_2_se,
+            "{fastest:?}"
+        );
         // Of the slowest frame, the half-millisecond budget falls within the curve too.
         let slowest = against_fixed(&rows, &fixed, &budget, Axis::Slowest);
         let budgets: Vec<f32> = slowest.iter().map(|a| a.budget_ms).collect();
@@ -702,6 +795,7 @@ mod tests {
         // The 99th-percentile frames here are the wall times: the same as on average.
         let p99 = against_fixed(&rows, &fixed, &budget, Axis::P99);
         assert_eq!(format!("{p99:?}"), format!("{against:?}"));
+        assert_eq!(settings[5].label(), "4 ms from 3/ms");
     }
 
     #[test]
