@@ -276,16 +276,13 @@ impl Axis {
     /// The panel's title and its y axis.
     fn panel(self) -> (&'static str, &'static str) {
         match self {
-            Axis::Mean => (
-                "speed on average against outcome",
-                "speed-up over all rigid (wall time, on average)",
-            ),
+            Axis::Mean => ("speed on average", "speed-up over all rigid (wall time, on average)"),
             Axis::Slowest => (
-                "the frame rate guaranteed against outcome",
+                "the frame rate guaranteed",
                 "speed-up of the slowest frame over all rigid's (cost model)",
             ),
             Axis::P99 => (
-                "the frame rate held, measured, against outcome",
+                "the frame rate held, measured",
                 "speed-up of the 99th-percentile frame (measured wall time)",
             ),
         }
@@ -553,7 +550,7 @@ fn finish(
             .map(|p| (p.mean_difference, axis.of(p), format!("  {}", p.of.label())))
             .collect();
         Panel {
-            title: format!("{title} ({} trials of {} s each)", s.trials, s.seconds),
+            title: format!("{title} ({} trials of {} s)", s.trials, s.seconds),
             x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
             y_label: y_label.into(),
             series: [
