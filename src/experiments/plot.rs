@@ -113,26 +113,60 @@ pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel]) -> Result<()
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
-/// The corner for the legend that hides the fewest points: upper right unless data lie there.
-fn legend_corner(p: &Panel, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> SeriesLabelPosition {
-    let fraction = |v: f64, lo: f64, hi: f64, log: bool| {
-        if log {
-            (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
-        } else {
-            (v - lo) / (hi - lo)
-        }
-    };
+/// A panel's frame around its plot, in pixels: the margin on every side, the title's and the
+/// axes' label areas; and the fonts' sizes.
+const MARGIN_PX: u32 = 12;
+const X_LABELS_PX: u32 = 45;
+const Y_LABELS_PX: u32 = 70;
+const TITLE_PT: u32 = 20;
+const LEGEND_PT: u32 = 14;
+
+/// The legend's share of the plot's width and height: its longest label and its rows measured
+/// in its font, with plotters' marker column and padding around them.
+fn legend_share(area: &Area, p: &Panel) -> (f64, f64) {
+    let (w, h) = area.dim_in_pixel();
+    let plot_w = w.saturating_sub(2 * MARGIN_PX + Y_LABELS_PX).max(1);
+    let plot_h = h.saturating_sub(2 * MARGIN_PX + X_LABELS_PX + 2 * TITLE_PT).max(1);
+    let font: TextStyle = ("sans-serif", LEGEND_PT).into();
+    let (widest, tallest) = p
+        .series
+        .iter()
+        .filter_map(|s| area.estimate_text_size(&s.label, &font).ok())
+        .fold((0, 0), |(w, h), (tw, th)| (w.max(tw), h.max(th)));
+    let rows = p.series.len() as u32;
+    (
+        (f64::from(widest + 50) / f64::from(plot_w)).min(1.0),
+        (f64::from(rows * (tallest + 6) + 14) / f64::from(plot_h)).min(0.9),
+    )
+}
+
+/// Where `v` lies between `lo` and `hi` on the axis, 0 to 1.
+fn fraction(v: f64, lo: f64, hi: f64, log: bool) -> f64 {
+    if log {
+        (v.ln() - lo.ln()) / (hi.ln() - lo.ln())
+    } else {
+        (v - lo) / (hi - lo)
+    }
+}
+
+/// The corner for the legend that hides the fewest points (upper right unless data lie
+/// there), and how many it hides.
+fn legend_corner(
+    p: &Panel,
+    (w, h): (f64, f64),
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> (SeriesLabelPosition, usize) {
     let points: Vec<(f64, f64)> = p
         .series
         .iter()
         .flat_map(|s| s.points.iter())
         .map(|&(x, y)| (fraction(x, x0, x1, false), fraction(y, y0, y1, p.log_y)))
         .collect();
-    // The legend takes about the outer 45 % of the width and 35 % of the height.
     let hidden = |right: bool, upper: bool| {
         points
             .iter()
-            .filter(|(x, y)| (if right { *x > 0.55 } else { *x < 0.45 }) && (if upper { *y > 0.65 } else { *y < 0.35 }))
+            .filter(|(x, y)| (if right { *x > 1.0 - w } else { *x < w }) && (if upper { *y > 1.0 - h } else { *y < h }))
             .count()
     };
     [
@@ -142,8 +176,21 @@ fn legend_corner(p: &Panel, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> Serie
         (SeriesLabelPosition::LowerLeft, false, false),
     ]
     .into_iter()
-    .min_by_key(|(_, right, upper)| hidden(*right, *upper))
-    .map_or(SeriesLabelPosition::UpperRight, |(corner, ..)| corner)
+    .map(|(corner, right, upper)| (corner, hidden(right, upper)))
+    .min_by_key(|(_, n)| *n)
+    .unwrap_or((SeriesLabelPosition::UpperRight, 0))
+}
+
+/// The top of a y axis from `y0` to `y1` raised so that the legend's share `h` of its height
+/// and a gap of 5 % lie above every point: where every corner has data, the legend goes over
+/// empty room.
+fn room_for_legend((y0, y1): (f64, f64), h: f64, log: bool) -> f64 {
+    let scale = 1.0 / (1.0 - h - 0.05).max(0.05);
+    if log {
+        (y0.ln() + (y1.ln() - y0.ln()) * scale).exp()
+    } else {
+        y0 + (y1 - y0) * scale
+    }
 }
 
 fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> {
@@ -158,14 +205,19 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
             [q.1 - e, q.1 + e]
         })
     });
-    let (y0, y1) = range(ys, p.log_y);
-    let legend = legend_corner(p, (x0, x1), (y0, y1));
+    let (y0, mut y1) = range(ys, p.log_y);
+    let share = legend_share(area, p);
+    let (mut legend, hidden) = legend_corner(p, share, (x0, x1), (y0, y1));
+    if hidden > 0 {
+        y1 = room_for_legend((y0, y1), share.1, p.log_y);
+        legend = SeriesLabelPosition::UpperRight;
+    }
     let mut builder = ChartBuilder::on(area);
     builder
-        .caption(&p.title, ("sans-serif", 20))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70);
+        .caption(&p.title, ("sans-serif", TITLE_PT))
+        .margin(MARGIN_PX)
+        .x_label_area_size(X_LABELS_PX)
+        .y_label_area_size(Y_LABELS_PX);
     let names = p.x_names.clone();
     let x_fmt = move |x: &f64| {
         if names.is_empty() {
@@ -233,7 +285,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK)
-                .label_font(("sans-serif", 14))
+                .label_font(("sans-serif", LEGEND_PT))
                 .position(legend)
                 .draw()?;
         }};
@@ -244,4 +296,45 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
         body!(builder.build_cartesian_2d(x0..x1, y0..y1)?);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A legend over 45 % of a plot's width and 35 % of its height.
+    const SHARE: (f64, f64) = (0.45, 0.35);
+
+    fn panel(points: Vec<(f64, f64)>) -> Panel {
+        Panel {
+            series: vec![Series::new("data", points, Mark::Line, 0)],
+            ..Panel::default()
+        }
+    }
+
+    #[test]
+    fn the_legend_takes_a_corner_without_data() {
+        let p = panel(vec![(0.0, 0.0), (1.0, 1.0)]);
+        let (corner, hidden) = legend_corner(&p, SHARE, (0.0, 1.0), (0.0, 1.0));
+        assert_eq!(hidden, 0);
+        assert!(matches!(
+            corner,
+            SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
+        ));
+    }
+
+    #[test]
+    fn where_every_corner_has_data_the_axis_grows_until_the_legend_hides_none() {
+        for (log, (lo, hi)) in [(false, (0.0, 1.0)), (true, (0.1, 10.0))] {
+            let p = Panel {
+                log_y: log,
+                ..panel(vec![(0.0, lo), (1.0, hi), (0.0, hi), (1.0, lo)])
+            };
+            assert!(legend_corner(&p, SHARE, (0.0, 1.0), (lo, hi)).1 > 0);
+            let grown = room_for_legend((lo, hi), SHARE.1, log);
+            let (corner, hidden) = legend_corner(&p, SHARE, (0.0, 1.0), (lo, grown));
+            assert_eq!(hidden, 0, "log axis: {log}");
+            assert!(matches!(corner, SeriesLabelPosition::UpperRight));
+        }
+    }
 }
