@@ -40,6 +40,14 @@ impl Series {
             colour,
         }
     }
+
+    /// What the series draws: each point's error bar's ends (the point twice without one).
+    fn reach(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
+        self.points.iter().enumerate().flat_map(|(i, &(x, y))| {
+            let e = self.errors.as_ref().map_or(0.0, |e| e[i]);
+            [(x, y - e), (x, y + e)]
+        })
+    }
 }
 
 /// One chart: axes with their units, series, a legend.
@@ -149,8 +157,8 @@ fn fraction(v: f64, lo: f64, hi: f64, log: bool) -> f64 {
     }
 }
 
-/// The corner for the legend that hides the fewest points (upper right unless data lie
-/// there), and how many it hides.
+/// The corner for the legend that hides the fewest points and error bars' ends (upper right
+/// unless data lie there), and how many it hides.
 fn legend_corner(
     p: &Panel,
     (w, h): (f64, f64),
@@ -160,8 +168,8 @@ fn legend_corner(
     let points: Vec<(f64, f64)> = p
         .series
         .iter()
-        .flat_map(|s| s.points.iter())
-        .map(|&(x, y)| (fraction(x, x0, x1, false), fraction(y, y0, y1, p.log_y)))
+        .flat_map(Series::reach)
+        .map(|(x, y)| (fraction(x, x0, x1, false), fraction(y, y0, y1, p.log_y)))
         .collect();
     let hidden = |right: bool, upper: bool| {
         points
@@ -199,13 +207,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
     if !p.x_names.is_empty() {
         (x0, x1) = (-0.5, p.x_names.len() as f64 - 0.5);
     }
-    let ys = p.series.iter().flat_map(|s| {
-        s.points.iter().enumerate().flat_map(move |(i, q)| {
-            let e = s.errors.as_ref().map_or(0.0, |e| e[i]);
-            [q.1 - e, q.1 + e]
-        })
-    });
-    let (y0, mut y1) = range(ys, p.log_y);
+    let (y0, mut y1) = range(p.series.iter().flat_map(Series::reach).map(|q| q.1), p.log_y);
     let share = legend_share(area, p);
     let (mut legend, hidden) = legend_corner(p, share, (x0, x1), (y0, y1));
     if hidden > 0 {
@@ -321,6 +323,16 @@ mod tests {
             corner,
             SeriesLabelPosition::UpperLeft | SeriesLabelPosition::LowerRight
         ));
+    }
+
+    #[test]
+    fn an_error_bar_reaching_into_a_corner_keeps_the_legend_out_of_it() {
+        let mut p = panel(vec![(0.0, 0.0), (1.0, 0.5)]);
+        assert_eq!(legend_corner(&p, SHARE, (0.0, 1.0), (0.0, 1.0)).1, 0);
+        p.series[0].errors = Some(vec![0.0, 0.5]);
+        let (corner, hidden) = legend_corner(&p, SHARE, (0.0, 1.0), (0.0, 1.0));
+        assert_eq!(hidden, 0);
+        assert!(!matches!(corner, SeriesLabelPosition::UpperRight));
     }
 
     #[test]
