@@ -497,8 +497,9 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
     );
     println!("collisions: {}", join(&s.collisions));
     println!(
-        "creatures that collided with the puck or a wall: {}",
-        s.creatures_collided
+        "creatures that collided with the puck or a wall: {} (with each: {})",
+        s.creatures_collided,
+        join(&s.creatures_collided_with)
     );
     println!(
         "falls: {} ({} within a step of going rigid), respawns: {}",

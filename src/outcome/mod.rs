@@ -95,6 +95,8 @@ pub struct Tally {
     pub removed_collisions: Counts<Obstacle, u64>,
     /// Removed creatures that had collided with the puck or a wall.
     pub removed_collided: u64,
+    /// Removed creatures that had collided with each obstacle.
+    pub removed_collided_with: Counts<Obstacle, u64>,
     pub falls: u64,
     /// Falls by the level the creature was at.
     pub falls_by_level: Counts<Lod, u64>,
@@ -333,6 +335,7 @@ fn respawn_fallen(
             u64::from(*lod == Lod::Rigid && choice.switched && now - choice.last_switch_s < gait.hop_period_s);
         for o in Obstacle::ALL {
             tally.removed_collisions[o] += u64::from(record.count[o as usize]);
+            tally.removed_collided_with[o] += u64::from(record.count[o as usize] > 0);
         }
         tally.removed_collided += u64::from(record.hit_puck_or_wall());
         tally.falls += 1;
@@ -378,6 +381,9 @@ pub struct Summary {
     pub collisions: Counts<Obstacle, u64>,
     /// Creatures that collided with the puck or a wall (the paper's figure 10 measure).
     pub creatures_collided: u64,
+    /// Creatures that collided with each obstacle at least once (figure 10's measure by
+    /// obstacle: a creature that hit both counts under each).
+    pub creatures_collided_with: Counts<Obstacle, u64>,
     pub falls: u64,
     /// Falls by the level the creature was at when it fell.
     pub falls_by_level: Counts<Lod, u64>,
@@ -416,6 +422,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         .then(|| world.resource::<BudgetTally>().summary(&config.rules.budget));
     let mut collisions = tally.removed_collisions;
     let mut collided = tally.removed_collided;
+    let mut collided_with = tally.removed_collided_with;
     let mut levels: Counts<Lod, u64> = Counts::default();
     let mut creatures = 0;
     let mut query = world.query::<(&Lod, &CollisionRecord)>();
@@ -424,6 +431,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         levels[lod] += 1;
         for o in Obstacle::ALL {
             collisions[o] += u64::from(record.count[o as usize]);
+            collided_with[o] += u64::from(record.count[o as usize] > 0);
         }
         collided += u64::from(record.hit_puck_or_wall());
     }
@@ -445,6 +453,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         creatures,
         collisions,
         creatures_collided: collided,
+        creatures_collided_with: collided_with,
         falls: tally.falls,
         falls_by_level: tally.falls_by_level,
         falls_after_switch: tally.falls_after_switch,

@@ -27,6 +27,7 @@ fn run_json_has_the_keys_of_the_summary() {
     for key in [
         "collisions",
         "creatures_collided",
+        "creatures_collided_with",
         "respawns",
         "falls_by_level",
         "levels",
@@ -52,6 +53,16 @@ fn run_json_has_the_keys_of_the_summary() {
     };
     let creatures = summary["creatures"].as_u64().unwrap();
     assert_eq!(total("levels"), creatures, "every creature is at one level: {summary}");
+    let with = |obstacle: &str| summary["creatures_collided_with"][obstacle].as_u64().unwrap();
+    let (puck, wall, collided) = (
+        with("puck"),
+        with("wall"),
+        summary["creatures_collided"].as_u64().unwrap(),
+    );
+    assert!(
+        puck.max(wall) <= collided && collided <= puck + wall,
+        "figure 10's count is the creatures that hit the puck or a wall: {summary}"
+    );
     let by_level = total("falls_by_level");
     assert_eq!(by_level, summary["falls"], "every fall is at one level: {summary}");
 }

@@ -70,6 +70,9 @@ fn a_creature_in_the_pucks_path_is_hit_and_counted() {
             // At 5 m/s the puck's impact beats the hopper's fall threshold of 2 m/s.
             assert_eq!(s.falls, 1);
             assert_eq!(s.creatures_collided, 1);
+            // Counted by obstacle too, after the fallen creature was removed.
+            assert_eq!(s.creatures_collided_with[Obstacle::Puck], 1);
+            assert_eq!(s.creatures_collided_with[Obstacle::Wall], 0);
             break;
         }
     }
