@@ -20,6 +20,7 @@ use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings, mean_and_variance, run_parallel, timed_game, trials};
 use crate::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
 use crate::lod::{LevelPolicy, Lod};
+use crate::outcome::{Counts, Obstacle};
 
 /// `assets/experiments/budget.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -134,7 +135,7 @@ impl Setting {
     }
 }
 
-const HEADER: &str = "policy,setting,least_benefit_per_ms,trial,seed,seconds,collided,collided_all_rigid,difference,mean_rigid,wall_s,wall_s_all_rigid,slowest_ms,slowest_ms_all_rigid,p99_ms,p99_ms_all_rigid";
+const HEADER: &str = "policy,setting,least_benefit_per_ms,trial,seed,seconds,collided,collided_all_rigid,difference,puck,puck_all_rigid,wall,wall_all_rigid,mean_rigid,wall_s,wall_s_all_rigid,slowest_ms,slowest_ms_all_rigid,p99_ms,p99_ms_all_rigid";
 
 /// One trial under one setting, beside the identical trial all rigid.
 struct Row {
@@ -143,6 +144,9 @@ struct Row {
     seed: u64,
     collided: u64,
     collided_all_rigid: u64,
+    /// The same by obstacle: the creatures that hit the puck, a wall, another creature.
+    collided_with: Counts<Obstacle, u64>,
+    collided_with_all_rigid: Counts<Obstacle, u64>,
     mean_rigid: f64,
     wall_s: f64,
     wall_s_all_rigid: f64,
@@ -157,6 +161,11 @@ struct Row {
 impl Row {
     fn difference(&self) -> f64 {
         self.collided as f64 - self.collided_all_rigid as f64
+    }
+
+    /// The difference in the creatures that hit `obstacle`.
+    fn difference_with(&self, obstacle: Obstacle) -> f64 {
+        self.collided_with[obstacle] as f64 - self.collided_with_all_rigid[obstacle] as f64
     }
 }
 
@@ -197,6 +206,8 @@ fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[
                 seed,
                 collided: run.1.creatures_collided,
                 collided_all_rigid: rigid.1.creatures_collided,
+                collided_with: run.1.creatures_collided_with,
+                collided_with_all_rigid: rigid.1.creatures_collided_with,
                 mean_rigid: run.1.levels_mean[Lod::Rigid],
                 wall_s: run.1.wall_seconds,
                 wall_s_all_rigid: rigid.1.wall_seconds,
@@ -232,6 +243,10 @@ struct Point {
     sd_difference: f64,
     /// The standard error of the mean difference.
     se_difference: f64,
+    /// The mean difference in the creatures that hit the puck, and in those that hit a wall,
+    /// each with its standard error: whether the two cancel in `mean_difference`.
+    puck_difference: (f64, f64),
+    wall_difference: (f64, f64),
     mean_rigid: f64,
     /// All rigid's wall time over the policy's.
     speedup: f64,
@@ -400,6 +415,10 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
             let mean = |f: &dyn Fn(&Row) -> f64| at.iter().map(|r| f(r)).sum::<f64>() / n;
             let (mean_difference, sd_difference, se_difference) =
                 mean_sd_se(&at.iter().map(|r| r.difference()).collect::<Vec<_>>());
+            let with = |o: Obstacle| {
+                let (mean, _, se) = mean_sd_se(&at.iter().map(|r| r.difference_with(o)).collect::<Vec<_>>());
+                (mean, se)
+            };
             Point {
                 of: setting,
                 policy: setting.policy(),
@@ -410,6 +429,8 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
                 mean_abs_difference: mean(&|r| r.difference().abs()),
                 sd_difference,
                 se_difference,
+                puck_difference: with(Obstacle::Puck),
+                wall_difference: with(Obstacle::Wall),
                 mean_rigid: mean(&|r| r.mean_rigid),
                 speedup: at.iter().map(|r| r.wall_s_all_rigid).sum::<f64>() / at.iter().map(|r| r.wall_s).sum::<f64>(),
                 slowest_ms: mean(&|r| r.slowest_ms),
@@ -518,7 +539,7 @@ fn finish(
     for r in rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:.3},{:.4},{:.4},{:.4},{:.4},{:.4},{:.4}",
             r.setting.policy(),
             r.setting.value(),
             r.setting.least_benefit_per_ms(),
@@ -528,6 +549,10 @@ fn finish(
             r.collided,
             r.collided_all_rigid,
             r.difference(),
+            r.collided_with[Obstacle::Puck],
+            r.collided_with_all_rigid[Obstacle::Puck],
+            r.collided_with[Obstacle::Wall],
+            r.collided_with_all_rigid[Obstacle::Wall],
             r.mean_rigid,
             r.wall_s,
             r.wall_s_all_rigid,
@@ -609,24 +634,29 @@ fn finish(
         "The budget policy (issue 14) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
          The difference is the policy's creatures that collided with the puck or a wall minus all rigid's; \
-         the difference without its sign is averaged too; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`); \
+         the difference without its sign is averaged too, and the difference is split by obstacle (the creatures that hit the puck, those that hit a wall; \
+         one that hit both counts in each): two errors of opposite sign cancel in the difference; the speed-up the all-rigid trials' wall time over the policy's (trials ran in parallel, `--jobs`); \
          the slowest frame each trial's slowest as the cost model predicts it from the levels simulated (the court's fixed cost and each creature's level), \
          and its speed-up all rigid's over the policy's: the frame rate a policy holds is set by its slowest frame; \
          the 99th-percentile frame each trial's measured wall times' (all but its slowest hundredth of frames, 6 of a 20 s trial's 600: the first, which builds the world, and the machine's hiccups), \
          and its speed-up likewise.\n\n\
-         | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | rigid creatures (mean) | speed-up | slowest frame (ms, cost model) | its speed-up | 99th-percentile frame (ms, measured) | its speed-up |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+         | policy | setting | difference: mean +- s.e. | difference without sign: mean | s.d. | hit the puck: difference | hit a wall: difference | rigid creatures (mean) | speed-up | slowest frame (ms, cost model) | its speed-up | 99th-percentile frame (ms, measured) | its speed-up |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
         s.trials, s.seconds, s.first_seed, s.fixed_rules, s.budget_rules
     );
     for p in points {
         let _ = writeln!(
             report,
-            "| {} | {} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            "| {} | {} | {:+.2} +- {:.2} | {:.2} | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
             p.policy,
             p.of.label(),
             p.mean_difference,
             p.se_difference,
             p.mean_abs_difference,
             p.sd_difference,
+            p.puck_difference.0,
+            p.puck_difference.1,
+            p.wall_difference.0,
+            p.wall_difference.1,
             p.mean_rigid,
             p.speedup,
             p.slowest_ms,
@@ -718,6 +748,8 @@ mod tests {
                 seed: u64::from(trial),
                 collided,
                 collided_all_rigid: 10 * u64::from(trial % 2),
+                collided_with: Counts::from_fn(|o| if o == Obstacle::Wall { collided } else { 0 }),
+                collided_with_all_rigid: Counts::default(),
                 mean_rigid: 0.0,
                 wall_s,
                 wall_s_all_rigid: 8.0,
@@ -761,6 +793,11 @@ mod tests {
         .flat_map(|((collided, wall_s, slowdown), setting)| trials(setting, collided, wall_s, slowdown))
         .collect();
         let points = summarise(&rows, &settings);
+        // By obstacle: here every collided creature hit a wall and none the puck.
+        assert_eq!(
+            (points[0].wall_difference.0, points[0].puck_difference),
+            (2.0, (0.0, 0.0))
+        );
         let [fixed, budget] =
             ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
         let against = against_fixed(&rows, &fixed, &budget, Axis::Mean);
