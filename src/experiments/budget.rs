@@ -8,7 +8,10 @@
 //!    the slowest frame as the cost model predicts it from the levels simulated (what a policy
 //!    guarantees: the frame rate it holds is set by its slowest frame); and of the 99th
 //!    percentile of the frames' measured wall times (figure 8's lowest frame rate, less the
-//!    start-up frame and the machine's hiccups).
+//!    start-up frame and the machine's hiccups). Each budget is weighed against the radii at
+//!    its speed-up twice: on figure 10's count, and on the error by obstacle (the change at the
+//!    puck and at the walls, each without its sign, added), where errors of opposite sign at
+//!    the two obstacles cannot cancel.
 //! 2. The crowd: one game of many creatures under all rigid, the influence policy and the
 //!    budget policy, every frame timed (can it hold 30 frames a second?).
 
@@ -313,7 +316,61 @@ impl Axis {
     }
 }
 
-/// A budget's point against the fixed-radius curve at the same speed-up.
+/// What an outcome's change from all rigid is measured by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Measure {
+    /// Figure 10's: the change in creatures that collided with the puck or a wall, with its sign.
+    Count,
+    /// The change in creatures that hit the puck and in those that hit a wall, each without its
+    /// sign, added: two errors of opposite sign do not cancel.
+    ByObstacle,
+}
+
+impl Measure {
+    /// A trial's changes that the measure adds, each taken with the sign of its mean.
+    fn parts(self, r: &Row) -> Vec<f64> {
+        match self {
+            Measure::Count => vec![r.difference()],
+            Measure::ByObstacle => vec![r.difference_with(Obstacle::Puck), r.difference_with(Obstacle::Wall)],
+        }
+    }
+
+    fn of(self, p: &Point) -> f64 {
+        match self {
+            Measure::Count => p.mean_difference,
+            Measure::ByObstacle => p.puck_difference.0.abs() + p.wall_difference.0.abs(),
+        }
+    }
+
+    fn x_label(self) -> &'static str {
+        match self {
+            Measure::Count => "change in creatures that hit the puck or a wall (mean, against all rigid)",
+            Measure::ByObstacle => "error by obstacle: |change at the puck| + |change at the walls| (means)",
+        }
+    }
+}
+
+/// A budget's point against the fixed-radius curve at the same speed-up, on one measure.
+#[derive(Clone, Debug, Serialize)]
+struct Comparison {
+    /// The budget's change (the count's with its sign) and its standard error.
+    difference: f64,
+    se_difference: f64,
+    /// The fixed-radius curve's at this speed-up, interpolated trial by trial in log speed-up
+    /// between the radii on either side; beyond the fastest radius, the fastest radius's
+    /// (slower than the budget: no radius reaches its speed-up).
+    fixed_difference: f64,
+    fixed_se_difference: f64,
+    /// How much nearer all rigid's outcome the budget's is than the fixed radii's (negative:
+    /// farther), and its standard error, both from each trial's pair of games: where the two
+    /// changes have the same sign the all-rigid game cancels out of each trial's gap.
+    gap: f64,
+    se_gap: f64,
+    /// The gap is over two of its standard errors.
+    nearer_beyond_2_se: bool,
+}
+
+/// A budget against the fixed-radius curve at the same speed-up.
 #[derive(Clone, Debug, Serialize)]
 struct Against {
     budget_ms: f32,
@@ -321,20 +378,11 @@ struct Against {
     #[serde(skip)]
     label: String,
     speedup: f64,
-    difference: f64,
-    se_difference: f64,
-    /// The fixed-radius curve's mean difference and standard error at this speed-up,
-    /// interpolated in log speed-up between the radii on either side; beyond the fastest
-    /// radius, the fastest radius's (slower than the budget: no radius reaches its speed-up).
-    fixed_difference: f64,
-    fixed_se_difference: f64,
-    /// How much nearer all rigid's outcome the budget's is than the fixed radii's (negative:
-    /// farther), and its standard error, both from each trial's pair of games: where the two
-    /// differences have the same sign the all-rigid game cancels out of each trial's gap.
-    gap: f64,
-    se_gap: f64,
-    /// The gap is over two of its standard errors.
-    nearer_beyond_2_se: bool,
+    /// On figure 10's count.
+    #[serde(flatten)]
+    count: Comparison,
+    /// On the error by obstacle.
+    by_obstacle: Comparison,
     /// Faster than every radius: set against the fastest.
     beyond_fastest_radius: bool,
 }
@@ -345,20 +393,55 @@ fn mean_sd_se(values: &[f64]) -> (f64, f64, f64) {
     (mean, variance.sqrt(), (variance / values.len() as f64).sqrt())
 }
 
+/// The budget's trials against the fixed radii's, interpolated trial by trial with weight `w`
+/// from `lo` to `hi`, on `measure`: each part of a trial's change is taken with the sign of its
+/// mean, so each side's mean is the size of its change and the gap how much smaller the
+/// budget's is.
+fn compare(rows: &[Row], budget: Setting, (lo, hi, w): (Setting, Setting, f64), measure: Measure) -> Comparison {
+    let parts = |setting: Setting| -> Vec<Vec<f64>> {
+        let mut at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
+        at.sort_by_key(|r| r.trial);
+        at.iter().map(|r| measure.parts(r)).collect()
+    };
+    let (at_lo, at_hi) = (parts(lo), parts(hi));
+    let fixed: Vec<Vec<f64>> = at_lo
+        .iter()
+        .zip(&at_hi)
+        .map(|(l, h)| l.iter().zip(h).map(|(l, h)| l + w * (h - l)).collect())
+        .collect();
+    let budget = parts(budget);
+    let signed = |trials: &[Vec<f64>]| -> (Vec<f64>, f64) {
+        let n = trials.len().max(1) as f64;
+        let signs: Vec<f64> = (0..trials.first().map_or(0, Vec::len))
+            .map(|i| (trials.iter().map(|t| t[i]).sum::<f64>() / n).signum())
+            .collect();
+        let sizes = trials.iter().map(|t| t.iter().zip(&signs).map(|(d, s)| d * s).sum()).collect();
+        // The count keeps its sign, as figure 10 plots it.
+        (sizes, if measure == Measure::Count { signs[0] } else { 1.0 })
+    };
+    let ((fixed, fixed_sign), (budget, budget_sign)) = (signed(&fixed), signed(&budget));
+    let gaps: Vec<f64> = fixed.iter().zip(&budget).map(|(f, b)| f - b).collect();
+    let (gap, _, se_gap) = mean_sd_se(&gaps);
+    let (difference, _, se_difference) = mean_sd_se(&budget);
+    let (fixed_difference, _, fixed_se_difference) = mean_sd_se(&fixed);
+    Comparison {
+        difference: budget_sign * difference,
+        se_difference,
+        fixed_difference: fixed_sign * fixed_difference,
+        fixed_se_difference,
+        gap,
+        se_gap,
+        nearer_beyond_2_se: gap > 2.0 * se_gap,
+    }
+}
+
 /// Each budget point that lies within the fixed-radius curve's range of speed-ups on `axis`, or
 /// beyond its fastest end, against that curve at its speed-up (figure 10's axes: the nearer
-/// zero the difference, the better); beyond the fastest radius, against the fastest radius,
-/// which is slower. Budgets slower than every radius are left out.
-/// Trial by trial, the fixed radii's difference is interpolated between the two radii on either
-/// side, and the gap is how much nearer zero the budget's is, the signs those of the means.
+/// zero the change, the better), on the count and by obstacle; beyond the fastest radius,
+/// against the fastest radius, which is slower. Budgets slower than every radius are left out.
 fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) -> Vec<Against> {
     let mut curve: Vec<&Point> = fixed.to_vec();
     curve.sort_by(|a, b| axis.of(a).total_cmp(&axis.of(b)));
-    let differences = |setting: Setting| -> Vec<f64> {
-        let mut at: Vec<&Row> = rows.iter().filter(|r| r.setting == setting).collect();
-        at.sort_by_key(|r| r.trial);
-        at.iter().map(|r| r.difference()).collect()
-    };
     let Some(&fastest) = curve.last() else {
         return Vec::new();
     };
@@ -378,28 +461,14 @@ fn against_fixed(rows: &[Row], fixed: &[&Point], budget: &[&Point], axis: Axis) 
                 None if speedup > axis.of(fastest) => (fastest, fastest, 0.0, true),
                 None => return None,
             };
-            let at = |f: fn(&Point) -> f64| f(lo) + w * (f(hi) - f(lo));
-            let (fixed_difference, fixed_se_difference) = (at(|p| p.mean_difference), at(|p| p.se_difference));
-            let (sign_fixed, sign_budget) = (fixed_difference.signum(), b.mean_difference.signum());
-            let (d_lo, d_hi) = (differences(lo.of), differences(hi.of));
-            let gaps: Vec<f64> = differences(b.of)
-                .iter()
-                .zip(d_lo.iter().zip(&d_hi))
-                .map(|(d_b, (d_lo, d_hi))| sign_fixed * (d_lo + w * (d_hi - d_lo)) - sign_budget * d_b)
-                .collect();
-            let (gap, _, se_gap) = mean_sd_se(&gaps);
+            let on = |measure| compare(rows, b.of, (lo.of, hi.of, w), measure);
             Some(Against {
                 budget_ms: b.setting,
                 least_benefit_per_ms: b.least_benefit_per_ms,
                 label: b.of.label(),
                 speedup,
-                difference: b.mean_difference,
-                se_difference: b.se_difference,
-                fixed_difference,
-                fixed_se_difference,
-                gap,
-                se_gap,
-                nearer_beyond_2_se: gap > 2.0 * se_gap,
+                count: on(Measure::Count),
+                by_obstacle: on(Measure::ByObstacle),
                 beyond_fastest_radius: beyond,
             })
         })
@@ -566,17 +635,18 @@ fn finish(
     let (fixed, budget) = (curve("influence"), curve("budget"));
     let against = Axis::ALL.map(|axis| (axis, against_fixed(rows, &fixed, &budget, axis)));
     let (ceilings, targets): (Vec<&Point>, Vec<&Point>) = budget.iter().partition(|p| p.least_benefit_per_ms > 0.0);
-    let trade_off = |axis: Axis| {
+    let trade_off = |(axis, measure): (Axis, Measure)| {
         let (title, y_label) = axis.panel();
-        let trade = |ps: &[&Point]| ps.iter().map(|p| (p.mean_difference, axis.of(p))).collect::<Vec<_>>();
+        let trade = |ps: &[&Point]| ps.iter().map(|p| (measure.of(p), axis.of(p))).collect::<Vec<_>>();
         let notes = fixed
             .iter()
             .chain(&budget)
-            .map(|p| (p.mean_difference, axis.of(p), format!("  {}", p.of.label())))
+            .map(|p| (measure.of(p), axis.of(p), format!("  {}", p.of.label())))
             .collect();
+        let by = if measure == Measure::ByObstacle { "by obstacle, " } else { "" };
         Panel {
-            title: format!("{title} ({} trials of {} s)", s.trials, s.seconds),
-            x_label: "change in creatures that hit the puck or a wall (mean, against all rigid)".into(),
+            title: format!("{by}{title} ({} trials of {} s)", s.trials, s.seconds),
+            x_label: measure.x_label().into(),
             y_label: y_label.into(),
             series: [
                 ("fixed puck radius (figure 10's rule)", &fixed, 0),
@@ -618,8 +688,10 @@ fn finish(
         5,
     ));
     let panels: Vec<Panel> = Axis::ALL
-        .map(trade_off)
+        .map(|axis| (axis, Measure::Count))
         .into_iter()
+        .chain([(Axis::Mean, Measure::ByObstacle)])
+        .map(trade_off)
         .chain([Panel {
             title: format!("frame times of a game of {} creatures", s.crowd_creatures),
             x_label: "simulated time (s)".into(),
@@ -629,7 +701,7 @@ fn finish(
             ..Panel::default()
         }])
         .collect();
-    plot::draw(&out.join("budget.png"), 2400, 600, &panels)?;
+    plot::draw(&out.join("budget.png"), 3000, 600, &panels)?;
     let mut report = format!(
         "The budget policy (issue 14) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
@@ -670,7 +742,9 @@ fn finish(
         "\nEach budget against the fixed radii at the same speed-up (their curve interpolated in log speed-up; a budget faster \
          than every radius against the fastest radius, which is slower; one slower than every radius left out). Nearer zero is nearer all rigid's outcome. The gap is how much nearer the budget's \
          is, taken trial by trial: each trial's budget game against its fixed-radius games, so that the all-rigid game's chance \
-         cancels where both differences have the same sign. First at the same speed-up on average (figure 10's), then at the \
+         cancels where both differences have the same sign. Each on figure 10's count, and by obstacle: the change at the puck \
+         and at the walls each without its sign, added (each part of a trial's change taken with the sign of its mean), \
+         where two errors of opposite sign do not cancel. First at the same speed-up on average (figure 10's), then at the \
          same speed-up of the slowest frame (the frame rate guaranteed), then of the 99th-percentile frame measured.\n"
     );
     for (axis, against) in &against {
@@ -709,26 +783,36 @@ fn finish(
 fn against_table(report: &mut String, axis: &str, against: &[Against]) {
     let _ = write!(
         report,
-        "\n| budget | {axis} | difference +- s.e. | fixed radii at that {axis} | gap +- s.e. (trial by trial) | nearer all rigid by over 2 s.e. |\n|---|---|---|---|---|---|\n"
+        "\n| budget | {axis} | difference +- s.e. | fixed radii at that {axis} | gap +- s.e. (trial by trial) | nearer all rigid by over 2 s.e. \
+         | by obstacle: budget | fixed radii | gap +- s.e. | nearer by over 2 s.e. |\n|---|---|---|---|---|---|---|---|---|---|\n"
     );
+    let yes = |c: &Comparison| if c.nearer_beyond_2_se { "yes" } else { "no" };
     for a in against {
+        let (c, o) = (&a.count, &a.by_obstacle);
         let _ = writeln!(
             report,
-            "| {} | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2}{} | {:+.2} +- {:.2} | {} |",
+            "| {} | {:.2} | {:+.2} +- {:.2} | {:+.2} +- {:.2}{} | {:+.2} +- {:.2} | {} | {:.2} +- {:.2} | {:.2} +- {:.2} | {:+.2} +- {:.2} | {} |",
             a.label,
             a.speedup,
-            a.difference,
-            a.se_difference,
-            a.fixed_difference,
-            a.fixed_se_difference,
+            c.difference,
+            c.se_difference,
+            c.fixed_difference,
+            c.fixed_se_difference,
             if a.beyond_fastest_radius {
                 " (the fastest radius, slower)"
             } else {
                 ""
             },
-            a.gap,
-            a.se_gap,
-            if a.nearer_beyond_2_se { "yes" } else { "no" }
+            c.gap,
+            c.se_gap,
+            yes(c),
+            o.difference,
+            o.se_difference,
+            o.fixed_difference,
+            o.fixed_se_difference,
+            o.gap,
+            o.se_gap,
+            yes(o)
         );
     }
 }
@@ -806,30 +890,73 @@ mod tests {
         // Differences of -3 and -2 on average, each with a standard error of 2.9 from the
         // all-rigid games alone; trial by trial the budget is 1 nearer every time.
         let (one_ms, two_ms) = (&against[0], &against[1]);
-        assert!((one_ms.fixed_difference + 3.0).abs() < 1e-9, "{one_ms:?}");
-        assert!((one_ms.difference + 2.0).abs() < 1e-9);
-        assert!(one_ms.se_difference > 2.0);
-        assert!((one_ms.gap - 1.0).abs() < 1e-9 && one_ms.se_gap < 1e-9);
-        assert!(one_ms.nearer_beyond_2_se);
+        assert!((one_ms.count.fixed_difference + 3.0).abs() < 1e-9, "{one_ms:?}");
+        assert!((one_ms.count.difference + 2.0).abs() < 1e-9);
+        assert!(one_ms.count.se_difference > 2.0);
+        assert!((one_ms.count.gap - 1.0).abs() < 1e-9 && one_ms.count.se_gap < 1e-9);
+        assert!(one_ms.count.nearer_beyond_2_se);
         // +9 against -3: farther.
-        assert!((two_ms.gap + 6.0).abs() < 1e-9, "{two_ms:?}");
-        assert!(!two_ms.nearer_beyond_2_se && !two_ms.beyond_fastest_radius);
+        assert!((two_ms.count.gap + 6.0).abs() < 1e-9, "{two_ms:?}");
+        assert!(!two_ms.count.nearer_beyond_2_se && !two_ms.beyond_fastest_radius);
         // Faster than every radius, against the fastest (0 m, -3): 1 nearer every time.
         let fastest = &against[2];
-        assert!(fastest.beyond_fastest_radius && (fastest.fixed_difference + 3.0).abs() < 1e-9);
+        assert!(fastest.beyond_fastest_radius && (fastest.count.fixed_difference + 3.0).abs() < 1e-9);
         assert!(
-            (fastest.gap - 1.0).abs() < 1e-9 && fastest.nearer_beyond_2_se,
+            (fastest.count.gap - 1.0).abs() < 1e-9 && fastest.count.nearer_beyond_2_se,
             "{fastest:?}"
         );
         // Of the slowest frame, the half-millisecond budget falls within the curve too.
         let slowest = against_fixed(&rows, &fixed, &budget, Axis::Slowest);
         let budgets: Vec<f32> = slowest.iter().map(|a| a.budget_ms).collect();
         assert_eq!(budgets, [1.0, 2.0, 0.5]);
-        assert!((slowest[2].speedup - 2.0).abs() < 1e-6 && (slowest[2].gap - 1.0).abs() < 1e-9);
+        assert!((slowest[2].speedup - 2.0).abs() < 1e-6 && (slowest[2].count.gap - 1.0).abs() < 1e-9);
         // The 99th-percentile frames here are the wall times: the same as on average.
         let p99 = against_fixed(&rows, &fixed, &budget, Axis::P99);
         assert_eq!(format!("{p99:?}"), format!("{against:?}"));
         assert_eq!(settings[5].label(), "4 ms from 3/ms");
+    }
+
+    #[test]
+    fn errors_of_opposite_sign_cancel_in_the_count_but_not_by_obstacle() {
+        let budget = Setting::Budget(BudgetPoint {
+            frame_budget_ms: 1.0,
+            least_benefit_per_ms: 0.0,
+        });
+        let settings = [Setting::Radius(8.0), Setting::Radius(0.0), budget];
+        // All rigid: one creature hits the puck and another a wall in every trial. The radii
+        // do the same (speed-ups 2 and 8); the budget (4) puts both on the puck, or on a wall
+        // in one trial of four.
+        let rows: Vec<Row> = settings
+            .iter()
+            .zip([4.0, 1.0, 2.0])
+            .flat_map(|(&setting, wall_s)| trials(setting, 2, wall_s, 1.0))
+            .map(|r| {
+                let on_puck = if r.setting == budget { 2 - 2 * u64::from(r.trial == 3) } else { 1 };
+                Row {
+                    collided_all_rigid: 2,
+                    collided_with: Counts::from_fn(|o| match o {
+                        Obstacle::Puck => on_puck,
+                        Obstacle::Wall => 2 - on_puck,
+                        Obstacle::Creature => 0,
+                    }),
+                    collided_with_all_rigid: Counts::from_fn(|o| u64::from(o != Obstacle::Creature)),
+                    ..r
+                }
+            })
+            .collect();
+        let points = summarise(&rows, &settings);
+        let [fixed, budgets] =
+            ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
+        let a = &against_fixed(&rows, &fixed, &budgets, Axis::Mean)[0];
+        // The count: no change on either side, no gap.
+        assert_eq!((a.count.difference, a.count.fixed_difference, a.count.gap), (0.0, 0.0, 0.0));
+        // By obstacle: +0.5 at the puck, -0.5 at the walls on average. Taken with the means'
+        // signs a trial's error is (+1) - (-1) = 2 three times and (-1) - (+1) = -2 once: 1 on
+        // average, against the radii's 0.
+        assert!((Measure::ByObstacle.of(&points[2]) - 1.0).abs() < 1e-9);
+        let o = &a.by_obstacle;
+        assert!((o.difference - 1.0).abs() < 1e-9 && o.fixed_difference == 0.0, "{o:?}");
+        assert!((o.gap + 1.0).abs() < 1e-9 && !o.nearer_beyond_2_se, "{o:?}");
     }
 
     #[test]
