@@ -415,7 +415,10 @@ fn compare(rows: &[Row], budget: Setting, (lo, hi, w): (Setting, Setting, f64), 
         let signs: Vec<f64> = (0..trials.first().map_or(0, Vec::len))
             .map(|i| (trials.iter().map(|t| t[i]).sum::<f64>() / n).signum())
             .collect();
-        let sizes = trials.iter().map(|t| t.iter().zip(&signs).map(|(d, s)| d * s).sum()).collect();
+        let sizes = trials
+            .iter()
+            .map(|t| t.iter().zip(&signs).map(|(d, s)| d * s).sum())
+            .collect();
         // The count keeps its sign, as figure 10 plots it.
         (sizes, if measure == Measure::Count { signs[0] } else { 1.0 })
     };
@@ -643,7 +646,11 @@ fn finish(
             .chain(&budget)
             .map(|p| (measure.of(p), axis.of(p), format!("  {}", p.of.label())))
             .collect();
-        let by = if measure == Measure::ByObstacle { "by obstacle, " } else { "" };
+        let by = if measure == Measure::ByObstacle {
+            "by obstacle, "
+        } else {
+            ""
+        };
         Panel {
             title: format!("{by}{title} ({} trials of {} s)", s.trials, s.seconds),
             x_label: measure.x_label().into(),
@@ -931,7 +938,11 @@ mod tests {
             .zip([4.0, 1.0, 2.0])
             .flat_map(|(&setting, wall_s)| trials(setting, 2, wall_s, 1.0))
             .map(|r| {
-                let on_puck = if r.setting == budget { 2 - 2 * u64::from(r.trial == 3) } else { 1 };
+                let on_puck = if r.setting == budget {
+                    2 - 2 * u64::from(r.trial == 3)
+                } else {
+                    1
+                };
                 Row {
                     collided_all_rigid: 2,
                     collided_with: Counts::from_fn(|o| match o {
@@ -949,7 +960,10 @@ mod tests {
             ["influence", "budget"].map(|p| points.iter().filter(|q| q.policy == p).collect::<Vec<_>>());
         let a = &against_fixed(&rows, &fixed, &budgets, Axis::Mean)[0];
         // The count: no change on either side, no gap.
-        assert_eq!((a.count.difference, a.count.fixed_difference, a.count.gap), (0.0, 0.0, 0.0));
+        assert_eq!(
+            (a.count.difference, a.count.fixed_difference, a.count.gap),
+            (0.0, 0.0, 0.0)
+        );
         // By obstacle: +0.5 at the puck, -0.5 at the walls on average. Taken with the means'
         // signs a trial's error is (+1) - (-1) = 2 three times and (-1) - (+1) = -2 once: 1 on
         // average, against the radii's 0.
