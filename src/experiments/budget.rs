@@ -420,7 +420,13 @@ fn compare(rows: &[Row], budget: Setting, (lo, hi, w): (Setting, Setting, f64), 
             .map(|t| t.iter().zip(&signs).map(|(d, s)| d * s).sum())
             .collect();
         // The count keeps its sign, as figure 10 plots it.
-        (sizes, if measure == Measure::Count { signs[0] } else { 1.0 })
+        (
+            sizes,
+            match measure {
+                Measure::Count => signs.first().copied().unwrap_or(1.0),
+                Measure::ByObstacle => 1.0,
+            },
+        )
     };
     let ((fixed, fixed_sign), (budget, budget_sign)) = (signed(&fixed), signed(&budget));
     let gaps: Vec<f64> = fixed.iter().zip(&budget).map(|(f, b)| f - b).collect();

@@ -88,15 +88,32 @@ impl FallQueue {
     }
 }
 
+/// Creatures' collision records added up.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CollisionTotals {
+    /// Collisions with each obstacle.
+    pub collisions: Counts<Obstacle, u64>,
+    /// Creatures that collided with each obstacle at least once.
+    pub collided_with: Counts<Obstacle, u64>,
+    /// Creatures that collided with the puck or a wall.
+    pub collided: u64,
+}
+
+impl CollisionTotals {
+    fn add(&mut self, record: &CollisionRecord) {
+        for o in Obstacle::ALL {
+            self.collisions[o] += u64::from(record.count[o as usize]);
+            self.collided_with[o] += u64::from(record.count[o as usize] > 0);
+        }
+        self.collided += u64::from(record.hit_puck_or_wall());
+    }
+}
+
 /// Counts kept for the whole run, beyond those of the creatures alive now.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct Tally {
-    /// Collisions of creatures already removed.
-    pub removed_collisions: Counts<Obstacle, u64>,
-    /// Removed creatures that had collided with the puck or a wall.
-    pub removed_collided: u64,
-    /// Removed creatures that had collided with each obstacle.
-    pub removed_collided_with: Counts<Obstacle, u64>,
+    /// The collision records of creatures already removed.
+    pub removed: CollisionTotals,
     pub falls: u64,
     /// Falls by the level the creature was at.
     pub falls_by_level: Counts<Lod, u64>,
@@ -333,11 +350,7 @@ fn respawn_fallen(
         let now = clock.seconds() as f32;
         tally.falls_after_switch +=
             u64::from(*lod == Lod::Rigid && choice.switched && now - choice.last_switch_s < gait.hop_period_s);
-        for o in Obstacle::ALL {
-            tally.removed_collisions[o] += u64::from(record.count[o as usize]);
-            tally.removed_collided_with[o] += u64::from(record.count[o as usize] > 0);
-        }
-        tally.removed_collided += u64::from(record.hit_puck_or_wall());
+        tally.removed.add(record);
         tally.falls += 1;
         tally.falls_by_level[*lod] += 1;
         tally.respawns += 1;
@@ -420,20 +433,14 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     let seed = config.scenario.seed;
     let budget = (config.scenario.level_policy == LevelPolicy::Budget)
         .then(|| world.resource::<BudgetTally>().summary(&config.rules.budget));
-    let mut collisions = tally.removed_collisions;
-    let mut collided = tally.removed_collided;
-    let mut collided_with = tally.removed_collided_with;
+    let mut totals = tally.removed;
     let mut levels: Counts<Lod, u64> = Counts::default();
     let mut creatures = 0;
     let mut query = world.query::<(&Lod, &CollisionRecord)>();
     for (&lod, record) in query.iter(world) {
         creatures += 1;
         levels[lod] += 1;
-        for o in Obstacle::ALL {
-            collisions[o] += u64::from(record.count[o as usize]);
-            collided_with[o] += u64::from(record.count[o as usize] > 0);
-        }
-        collided += u64::from(record.hit_puck_or_wall());
+        totals.add(record);
     }
     let sim_seconds = clock.seconds();
     let switching = world.resource::<SwitchTally>().clone();
@@ -451,9 +458,9 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         budget,
         seed,
         creatures,
-        collisions,
-        creatures_collided: collided,
-        creatures_collided_with: collided_with,
+        collisions: totals.collisions,
+        creatures_collided: totals.collided,
+        creatures_collided_with: totals.collided_with,
         falls: tally.falls,
         falls_by_level: tally.falls_by_level,
         falls_after_switch: tally.falls_after_switch,
