@@ -337,10 +337,14 @@ struct PlayArgs {
     #[arg(long, value_parser = frame_budget_ms)]
     frame_budget: Option<f32>,
     /// Render `--frames` frames, save the window to this PNG file and quit.
-    #[arg(long, requires = "frames")]
+    #[arg(long, group = "capture", requires = "frames")]
     screenshot: Option<PathBuf>,
-    /// Frames to render before the screenshot.
-    #[arg(long, requires = "screenshot", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    /// Render `--frames` frames and save them to this file as an animated GIF (every
+    /// `recording.every_nth_frame`-th of them, `recording.width_px` wide: `game.ron`), then quit.
+    #[arg(long, group = "capture", requires = "frames")]
+    record: Option<PathBuf>,
+    /// Frames to render (each 1/30 s of the game) for `--screenshot` or `--record`.
+    #[arg(long, requires = "capture", value_parser = clap::value_parser!(u32).range(1..=100_000))]
     frames: Option<u32>,
 }
 
@@ -352,7 +356,14 @@ impl PlayArgs {
             assets: self.assets,
             policy: self.policy,
             frame_budget_ms: self.frame_budget,
-            screenshot: self.screenshot.zip(self.frames),
+            capture: self.frames.and_then(|frames| {
+                let (path, kind) = match (self.screenshot, self.record) {
+                    (Some(path), _) => (path, simlod::game::Capture::Screenshot),
+                    (None, Some(path)) => (path, simlod::game::Capture::Recording),
+                    (None, None) => return None,
+                };
+                Some(simlod::game::CapturePlan { path, frames, kind })
+            }),
         })
     }
 }

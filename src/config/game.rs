@@ -23,6 +23,7 @@ pub struct GameConfig {
     pub lighting: LightingConfig,
     pub hud: HudConfig,
     pub creature_look: CreatureLook,
+    pub recording: RecordingConfig,
 }
 
 /// The player's view (paper figure 6, bottom): behind the player on the line from the puck,
@@ -133,6 +134,17 @@ pub struct CreatureLook {
     pub nose_radius_fraction: f32,
 }
 
+/// `simlod play --record FILE.gif --frames N`: the animated picture of a round.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordingConfig {
+    /// The picture's width; its height keeps the window's shape. 64 to 4096 px.
+    pub width_px: u32,
+    /// One picture every this many frames (each frame is one steering decision, 1/30 s by
+    /// default); 1 to 30. The picture plays at the simulation's speed either way.
+    pub every_nth_frame: u32,
+}
+
 fn colour(v: &mut Validator, field: &str, c: Srgb) {
     v.nested(field, |v| {
         for (i, x) in c.into_iter().enumerate() {
@@ -216,6 +228,11 @@ impl Validate for GameConfig {
             v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
             v.range("leg_thickness_m", k.leg_thickness_m, 0.001, 1.0);
             v.within("nose_radius_fraction", k.nose_radius_fraction, 0.05, 1.0);
+        });
+        let r = &self.recording;
+        v.nested("recording", |v| {
+            v.within("width_px", r.width_px as f32, 64.0, 4096.0);
+            v.within("every_nth_frame", r.every_nth_frame as f32, 1.0, 30.0);
         });
     }
 }

@@ -19,7 +19,9 @@ pub use creature::{
     BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints, Stance,
     SteeringConfig,
 };
-pub use game::{CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, SceneColours, Srgb};
+pub use game::{
+    CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig, SceneColours, Srgb,
+};
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{BudgetRules, CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, MAX_CREATURES, MAX_DURATION_S, Scenario};

@@ -5,13 +5,13 @@
 //! desired velocity and starting the world over.
 
 mod camera;
+mod capture;
 mod controls;
 mod creatures;
 mod hud;
 pub mod player;
 pub mod reload;
 mod scene;
-mod screenshot;
 
 use bevy::asset::AssetMetaCheck;
 use bevy::prelude::*;
@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use crate::SimPlugin;
 use crate::config::{GameConfig, SimConfig, load_file};
 use crate::lod::LevelPolicy;
+pub use capture::{Capture, CapturePlan};
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {
@@ -31,8 +32,8 @@ pub struct PlayOptions {
     /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s), until the
     /// rules file is edited.
     pub frame_budget_ms: Option<f32>,
-    /// Render this many frames, save a screenshot here and quit.
-    pub screenshot: Option<(PathBuf, u32)>,
+    /// Render some frames, save a screenshot or a recording of them, and quit.
+    pub capture: Option<CapturePlan>,
 }
 
 /// The look of the game: the last good `assets/game.ron`.
@@ -56,6 +57,15 @@ pub fn play(options: PlayOptions) -> Result<(), String> {
         config.rules.budget.frame_budget_ms = ms;
     }
     let looks: GameConfig = load_file(&options.assets.join(GAME_FILE)).map_err(|e| e.to_string())?;
+    if let Some(plan) = &options.capture
+        && plan.kind == Capture::Recording
+        && plan.frames < looks.recording.every_nth_frame
+    {
+        return Err(format!(
+            "--frames {} records no picture: {GAME_FILE}'s recording.every_nth_frame is {}",
+            plan.frames, looks.recording.every_nth_frame
+        ));
+    }
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
     let mut app = App::new();
     add_window_plugins(&mut app, &options)?;
@@ -63,8 +73,8 @@ pub fn play(options: PlayOptions) -> Result<(), String> {
         .insert_resource(GameSettings(looks))
         .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone(), file_rules));
     plugin(&mut app);
-    if let Some((path, frames)) = options.screenshot {
-        screenshot::plugin(&mut app, path, frames);
+    if let Some(plan) = options.capture {
+        capture::plugin(&mut app, plan);
     }
     match app.run() {
         AppExit::Success => Ok(()),
