@@ -272,7 +272,7 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 /// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
 /// of the scenario alone, in a court scaled to its density: each level's median frame, less
 /// the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so
-/// one thread, as in a game), and the switch into the rigid level (see [`switch_cost_us`]). A
+/// one thread, as in a game), and the switch into the rigid level (see `switch_cost_us`). A
 /// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
 /// policy's own choice per creature, in the scenario's mix scaled up.
 pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {

@@ -16,6 +16,20 @@
 //! | rapier's `PhysicsSet`s | [`arena`] | the puck and walls (rapier bodies) |
 //! | [`SimStage::Observe`] | [`outcome`] | collisions with the puck, walls and other creatures |
 //! | [`SimStage::Outcome`] | [`outcome`] | fallen creatures removed and respawned; the clock |
+//!
+//! # Where to start
+//!
+//! - [`config::SimConfig::load`] reads a scenario and every file it names from an assets
+//!   folder, checked; [`SimPlugin`] adds the simulation it describes to an `App`.
+//! - [`headless::HeadlessSim`] drives that app a frame at a time without a window, and
+//!   [`headless::run`] runs a scenario and returns its [`outcome::Summary`].
+//! - Each creature is an entity with a [`creature::Creature`] and its level, [`lod::Lod`];
+//!   every level publishes [`creature::PlanarState`], [`creature::GaitPhase`] and
+//!   [`gait::GaitPose`], which is all the rest of the program reads.
+//! - The level policy and rules are fields of the [`config::SimConfig`] resource, read at
+//!   every steering decision: [`lod::LevelPolicy`], [`config::LevelRules`].
+//!
+//! The `examples/` folder has four runnable programs, and `docs/guide/` the user guide.
 
 /// Runs a closure over every item of a query, across threads only when there are enough
 /// creatures to pay for waking them.

@@ -250,7 +250,7 @@ impl SerialCounter {
 const PLACEMENT_ATTEMPTS: usize = 24;
 
 /// A random spot in the court at least `wanted` clear by `clearance`, or the clearest of
-/// [`PLACEMENT_ATTEMPTS`] tries. `margin` keeps the spot off the walls.
+/// `PLACEMENT_ATTEMPTS` tries. `margin` keeps the spot off the walls.
 pub fn find_free_spot(
     rng: &mut WorldRng,
     half: Vec2,

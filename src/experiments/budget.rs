@@ -1,4 +1,4 @@
-//! The budget experiment (beyond the paper, issue 14): the budget policy against the paper's
+//! The budget experiment (beyond the paper): the budget policy against the paper's
 //! fixed radii on figure 10's axes, and the frame times of a crowded game.
 //!
 //! 1. The trade-off: trials of a game from their own seeds, each all rigid, under the influence
@@ -716,7 +716,7 @@ fn finish(
         .collect();
     plot::draw(&out.join("budget.png"), 3000, 600, &panels)?;
     let mut report = format!(
-        "The budget policy (issue 14) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
+        "The budget policy (beyond the paper) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
          The difference is the policy's creatures that collided with the puck or a wall minus all rigid's; \
          the difference without its sign is averaged too, and the difference is split by obstacle (the creatures that hit the puck, those that hit a wall; \

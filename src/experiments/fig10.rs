@@ -438,7 +438,7 @@ fn finish(mut rows: Vec<Row>, out: &Path, command: &str, scenario: &Path, assets
             p.speedup
         );
     }
-    // Issue 15: switching must not add falls. Beyond noise: more than two standard errors of
+    // Switching must not add falls. Beyond noise: more than two standard errors of
     // the trial-by-trial difference.
     let more_falls: Vec<String> = per_radius
         .iter()

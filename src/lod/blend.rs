@@ -150,7 +150,7 @@ pub fn drawn(state: &PlanarState, pose: &GaitPose, blend: Option<&SwitchBlend>, 
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct DrawnBefore(pub Option<(Drawn, Drawn)>);
 
-/// A switch being measured over its first [`PROBE_TICKS`] ticks.
+/// A switch being measured over its first `PROBE_TICKS` ticks.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct SwitchProbe {
     pub from: Lod,

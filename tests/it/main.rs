@@ -6,6 +6,7 @@ mod budget;
 mod cli;
 mod court;
 mod determinism;
+mod docs;
 mod experiments;
 mod fuzz;
 mod gait;

@@ -83,7 +83,7 @@ pub struct Raibert {
     /// creature's acceleration limit, so a sudden change of mind does not trip it.
     pub command: Vec2,
     /// When the creature entered the rigid level, and each leg's length then: the idle legs'
-    /// servo starts from there (see [`Raibert::spring_target`]).
+    /// servo starts from there (see `Raibert::spring_target`).
     pub entry_s: f32,
     pub entry_lengths_m: [f32; MAX_LEGS],
 }
@@ -329,7 +329,7 @@ impl Raibert {
 
     /// The servo's target, eased in from each leg's length at entry over `idle_leg_swap_s`
     /// after entering the rigid level: a leg snapped toward a target far from its entry length
-    /// pops what is drawn (issue 15). Quintic: no jump in the target's speed or acceleration.
+    /// pops what is drawn. Quintic: no jump in the target's speed or acceleration.
     fn spring_target(&self, leg: (usize, &LegConfig), r: &RigidConfig, role: Role, together: bool, now: f32) -> f32 {
         let (i, leg) = leg;
         let servo = self.servo_target(leg, r, role, together, now);
