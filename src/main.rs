@@ -8,6 +8,7 @@ use std::process::ExitCode;
 use simlod::config::{
     CreatureDef, CreatureGroup, MAX_DURATION_S, MeasuredAnew, SimConfig, Validate, Validator, load_costs, load_file,
 };
+use simlod::gait::GaitTable;
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::{Counts, Key, Summary};
@@ -55,6 +56,9 @@ struct RecordGaitArgs {
     /// under the assets folder).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Write the table even where a table of another kind is: that kind loses its table.
+    #[arg(long)]
+    replace_other_kind: bool,
 }
 
 impl RecordGaitArgs {
@@ -96,7 +100,6 @@ impl RecordGaitArgs {
             speeds_m_per_s: speeds.clone(),
             ..defaults
         };
-        let table = record(&config, &def.name, &settings)?;
         let out = self.out.clone().unwrap_or_else(|| {
             self.scenario.assets.join(
                 def.gait_table
@@ -104,6 +107,22 @@ impl RecordGaitArgs {
                     .unwrap_or_else(|| format!("gaits/{}.ron", def.name)),
             )
         });
+        // Another kind's table is never overwritten by accident (a copied creature file
+        // that kept its original's `gait_table` line names the original's table).
+        if !self.replace_other_kind
+            && let Ok(old) = load_file::<GaitTable>(&out)
+            && old.creature != def.name
+        {
+            return Err(format!(
+                "{path} holds the gait table of `{other}`, not of `{kind}`: recording `{kind}` there would \
+                 take `{other}`'s table away. Give `{kind}` its own `gait_table` (or --out FILE), or pass \
+                 --replace-other-kind",
+                path = out.display(),
+                other = old.creature,
+                kind = def.name,
+            ));
+        }
+        let table = record(&config, &def.name, &settings)?;
         let speeds: Vec<String> = speeds.iter().map(f32::to_string).collect();
         let command = format!(
             "simlod record-gait --creature {} --speeds {}",
@@ -248,13 +267,13 @@ struct ScenarioArgs {
     #[arg(long, value_enum)]
     policy: Option<LevelPolicy>,
     /// Overrides the radius of the puck's area of influence (metres).
-    #[arg(long, value_parser = non_negative_metres)]
+    #[arg(long, allow_negative_numbers = true, value_parser = non_negative_metres)]
     puck_radius: Option<f32>,
     /// Overrides the camera's radius of influence (metres).
-    #[arg(long, value_parser = non_negative_metres)]
+    #[arg(long, allow_negative_numbers = true, value_parser = non_negative_metres)]
     camera_radius: Option<f32>,
     /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s, 0 to 10000).
-    #[arg(long, value_parser = frame_budget_ms)]
+    #[arg(long, allow_negative_numbers = true, value_parser = frame_budget_ms)]
     frame_budget: Option<f32>,
     /// Overrides the scenario's level rules file.
     #[arg(long)]
@@ -334,7 +353,7 @@ struct PlayArgs {
     policy: Option<LevelPolicy>,
     /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s, 0 to 10000; 9
     /// and 0 change it while playing).
-    #[arg(long, value_parser = frame_budget_ms)]
+    #[arg(long, allow_negative_numbers = true, value_parser = frame_budget_ms)]
     frame_budget: Option<f32>,
     /// Render `--frames` frames, save the window to this PNG file and quit.
     #[arg(long, group = "capture", requires = "frames")]
@@ -373,7 +392,7 @@ struct RunArgs {
     #[command(flatten)]
     scenario: ScenarioArgs,
     /// Simulated seconds (default: the scenario's duration).
-    #[arg(long, value_parser = positive_seconds)]
+    #[arg(long, allow_negative_numbers = true, value_parser = positive_seconds)]
     seconds: Option<f64>,
     /// Print the summary as one JSON object.
     #[arg(long)]

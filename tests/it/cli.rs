@@ -144,7 +144,10 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
     refused(&["run", "--policy", "sometimes"], "sometimes");
     refused(&["run", "--seconds", "soon"], "soon");
     refused(&["run", "--seconds", "1e6"], "10000");
-    refused(&["run", "--puck-radius", "-3"], "-3");
+    // A negative number reaches the range check, with or without `=`.
+    refused(&["run", "--puck-radius", "-3"], "between 0 and 10000 metres, got -3");
+    refused(&["run", "--frame-budget", "-1"], "10000 ms");
+    refused(&["run", "--seconds", "-2"], "more than 0");
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["play", "--frame-budget=-1"], "10000 ms");
@@ -176,4 +179,37 @@ fn experiment_flags_are_checked() {
         "--jobs",
     );
     refused(&["experiment", "merge", "/nowhere", "--out", "/tmp/x"], "/nowhere");
+}
+
+#[test]
+fn record_gait_refuses_to_overwrite_another_kinds_table_unless_told_to() {
+    // A copy of the hopper's file renamed, its `gait_table` line left in: it names the
+    // hopper's table.
+    let assets = crate::support::copy_assets("record_gait_other_kind");
+    let hopper = std::fs::read_to_string(assets.join("creatures/hopper.ron")).unwrap();
+    let copycat = hopper.replacen("name: \"hopper\"", "name: \"copycat\"", 1);
+    assert_ne!(copycat, hopper, "the hopper's file names its kind");
+    let file = assets.join("creatures/copycat.ron");
+    std::fs::write(&file, copycat).unwrap();
+    let table = assets.join("gaits/hopper.ron");
+    let before = std::fs::read(&table).unwrap();
+    let scenario = assets.join("scenarios/default.ron");
+    let args = [
+        "record-gait",
+        "--assets",
+        assets.to_str().unwrap(),
+        "--scenario",
+        scenario.to_str().unwrap(),
+        "--creature",
+        file.to_str().unwrap(),
+        "--speeds",
+        "0,1",
+    ];
+    refused(&args, "holds the gait table of `hopper`, not of `copycat`");
+    assert_eq!(std::fs::read(&table).unwrap(), before, "the hopper's table is untouched");
+    // Told to, it records there.
+    let out = simlod(&[&args[..], &["--replace-other-kind"]].concat());
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let written: simlod::gait::GaitTable = simlod::config::load_file(&table).unwrap();
+    assert_eq!(written.creature, "copycat");
 }

@@ -118,23 +118,6 @@ fn update_until(app: &mut App, what: &str, done: impl Fn(&mut App) -> bool) {
     }
 }
 
-fn copy_assets(test: &str) -> std::path::PathBuf {
-    fn copy_dir(from: &Path, to: &Path) {
-        std::fs::create_dir_all(to).unwrap();
-        for entry in std::fs::read_dir(from).unwrap().flatten() {
-            let (path, target) = (entry.path(), to.join(entry.file_name()));
-            if path.is_dir() {
-                copy_dir(&path, &target);
-            } else {
-                std::fs::copy(&path, &target).unwrap();
-            }
-        }
-    }
-    let dir = scratch_dir(test);
-    copy_dir(&assets_root(), &dir);
-    dir
-}
-
 #[test]
 fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restarts_the_round() {
     let root = copy_assets("hot_reload");

@@ -69,3 +69,21 @@ pub fn digest_after(config: SimConfig, seconds: f64) -> (u64, simlod::outcome::S
     summary.realtime_factor = 0.0;
     (sim.state_digest(), summary)
 }
+
+/// A copy of the shipped assets folder in a scratch folder of the test's own.
+pub fn copy_assets(test: &str) -> std::path::PathBuf {
+    fn copy_dir(from: &Path, to: &Path) {
+        std::fs::create_dir_all(to).unwrap();
+        for entry in std::fs::read_dir(from).unwrap().flatten() {
+            let (path, target) = (entry.path(), to.join(entry.file_name()));
+            if path.is_dir() {
+                copy_dir(&path, &target);
+            } else {
+                std::fs::copy(&path, &target).unwrap();
+            }
+        }
+    }
+    let dir = scratch_dir(test);
+    copy_dir(&assets_root(), &dir);
+    dir
+}
