@@ -206,7 +206,11 @@ fn record_gait_refuses_to_overwrite_another_kinds_table_unless_told_to() {
         "0,1",
     ];
     refused(&args, "holds the gait table of `hopper`, not of `copycat`");
-    assert_eq!(std::fs::read(&table).unwrap(), before, "the hopper's table is untouched");
+    assert_eq!(
+        std::fs::read(&table).unwrap(),
+        before,
+        "the hopper's table is untouched"
+    );
     // Told to, it records there.
     let out = simlod(&[&args[..], &["--replace-other-kind"]].concat());
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
