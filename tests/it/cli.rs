@@ -217,3 +217,17 @@ fn record_gait_refuses_to_overwrite_another_kinds_table_unless_told_to() {
     let written: simlod::gait::GaitTable = simlod::config::load_file(&table).unwrap();
     assert_eq!(written.creature, "copycat");
 }
+
+#[test]
+fn the_budget_line_says_when_the_measured_frame_is_over_the_budget() {
+    // 10 us cannot hold even the court: both the policy's choice and the wall time are over.
+    let out = simlod(&["run", "--policy", "budget", "--frame-budget", "0.01", "--seconds", "1"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("frame budget"))
+        .expect("a budget line");
+    assert!(line.contains("over it at 30 of 30 decisions"), "{line}");
+    assert!(line.contains("% over the budget") && !line.contains("within"), "{line}");
+}
