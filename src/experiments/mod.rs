@@ -204,22 +204,30 @@ pub struct ExperimentRecord {
 impl ExperimentRecord {
     /// Writes `<name>.csv`, `<name>.json` and the report (the plot is drawn before).
     pub fn finish(&self, out: &Path, csv: &str) -> Result<String, String> {
-        write_out(out, &format!("{}.csv", self.experiment), csv)?;
-        self.save(out)
+        let name = &self.experiment;
+        write_out(out, &format!("{name}.csv"), csv)?;
+        self.save(out, &[&format!("{name}.csv"), &format!("{name}.png")])
     }
 
-    /// Writes `<name>.json` and the report.
-    pub fn save(&self, out: &Path) -> Result<String, String> {
+    /// Writes `<name>.json` and the report, and says so with the `other` files the experiment
+    /// wrote before.
+    pub fn save(&self, out: &Path, other: &[&str]) -> Result<String, String> {
         let name = &self.experiment;
         let json = serde_json::to_string_pretty(self).expect("a record serialises");
         write_out(out, &format!("{name}.json"), &(json + "\n"))?;
         let report = report::write(out)?;
+        let report = report
+            .file_name()
+            .map_or_else(String::new, |f| f.to_string_lossy().into_owned());
+        let written: Vec<String> = other
+            .iter()
+            .map(|f| f.to_string())
+            .chain([format!("{name}.json")])
+            .collect();
         Ok(format!(
-            "{}\nwrote {name}.csv, {name}.png, {name}.json and {} in {}\n",
+            "{}\nwrote {} and {report} in {}\n",
             self.report.trim_end(),
-            report
-                .file_name()
-                .map_or_else(String::new, |f| f.to_string_lossy().into_owned()),
+            written.join(", "),
             out.display()
         ))
     }

@@ -193,7 +193,7 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
             experiment.duration_s
         ),
     };
-    summary += &record.save(out)?;
+    summary += &record.save(out, &["step-response.png"])?;
     Ok(summary)
 }
 

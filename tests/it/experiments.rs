@@ -13,6 +13,7 @@ fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
         "{summary}"
     );
     assert!(summary.contains("the models are"), "{summary}");
+    every_file_it_says_it_wrote_exists(&summary, &out);
     let velocity = std::fs::read_to_string(out.join("velocity.csv")).unwrap();
     let path = std::fs::read_to_string(out.join("path.csv")).unwrap();
     assert_eq!(velocity.lines().count(), 1 + 2 * 240);
@@ -83,6 +84,26 @@ use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
 use std::path::{Path, PathBuf};
 
+/// Each file an experiment's output says it wrote ("wrote a.csv, b.png and report.md in DIR",
+/// or "wrote /path/file") is there.
+fn every_file_it_says_it_wrote_exists(said: &str, out: &Path) {
+    let mut named = 0;
+    for line in said.lines().filter_map(|l| l.strip_prefix("wrote ")) {
+        let (files, dir) = line.rsplit_once(" in ").map_or((line, None), |(f, d)| (f, Some(d)));
+        for file in files.split(", ").flat_map(|f| f.split(" and ")) {
+            let path = dir.map_or_else(|| Path::new(file).to_path_buf(), |d| Path::new(d).join(file));
+            assert!(
+                path.is_file(),
+                "it says it wrote {}, which is not there: {said}",
+                path.display()
+            );
+            assert!(path.starts_with(out), "{} is in the output folder", path.display());
+            named += 1;
+        }
+    }
+    assert!(named >= 3, "it names what it wrote: {said}");
+}
+
 fn quick(out: &Path) -> Options {
     Options {
         out: out.to_owned(),
@@ -121,6 +142,7 @@ fn every_experiment_quick_writes_its_files_and_a_plot_that_is_not_blank() {
     for name in ["table1", "fig7", "fig8", "fig9", "fig10"] {
         let said = run(name, &quick(&out)).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(said.contains(&format!("wrote {name}.csv")), "{said}");
+        every_file_it_says_it_wrote_exists(&said, &out);
         for ext in ["csv", "png", "json"] {
             assert!(out.join(format!("{name}.{ext}")).is_file(), "{name}.{ext}");
         }
