@@ -302,6 +302,17 @@ fn frame_budget_ms(s: &str) -> Result<f32, String> {
 }
 
 impl ScenarioArgs {
+    fn what_ran(&self, config: &SimConfig) -> WhatRan {
+        WhatRan {
+            policy: policy_name(config.scenario.level_policy),
+            rules: self
+                .rules
+                .clone()
+                .unwrap_or_else(|| self.assets.join(&config.scenario.level_rules)),
+            cost_model: self.assets.join(&config.rules.budget.cost_model),
+        }
+    }
+
     fn load(&self) -> Result<SimConfig, String> {
         self.load_measuring(MeasuredAnew::default())
     }
@@ -397,6 +408,60 @@ struct RunArgs {
     /// Print the summary as one JSON object.
     #[arg(long)]
     json: bool,
+}
+
+impl RunArgs {
+    /// Simulates the scenario and prints what happened. A flag the run's policy never reads is
+    /// refused rather than ignored.
+    fn run(&self) -> Result<(), String> {
+        let config = self.scenario.load()?;
+        let policy = config.scenario.level_policy;
+        let unread = [
+            (
+                "--puck-radius",
+                self.scenario.puck_radius.is_some() && !policy.uses_puck_radius(),
+            ),
+            (
+                "--camera-radius",
+                self.scenario.camera_radius.is_some() && !policy.uses_camera_radius(),
+            ),
+            (
+                "--frame-budget",
+                self.scenario.frame_budget.is_some() && !policy.uses_frame_budget(),
+            ),
+        ];
+        if let Some((flag, _)) = unread.iter().find(|(_, unread)| *unread) {
+            return Err(format!(
+                "{flag} does not apply to the {} policy, which never reads it (choose a policy that does with --policy)",
+                policy_name(policy)
+            ));
+        }
+        let seconds = self.seconds.unwrap_or(f64::from(config.scenario.duration_s));
+        let summary = headless::run(config.clone(), seconds);
+        let ran = self.scenario.what_ran(&config);
+        if self.json {
+            let mut json = serde_json::to_value(&summary).expect("a summary serialises");
+            json["policy"] = ran.policy.into();
+            json["rules"] = ran.rules.display().to_string().into();
+            json["cost_model"] = ran.cost_model.display().to_string().into();
+            println!("{json}");
+        } else {
+            print_summary(self, &summary, &config, &ran);
+        }
+        Ok(())
+    }
+}
+
+/// What a run ran under: its level policy, as the command line names it, and the files of its
+/// level rules and cost model.
+struct WhatRan {
+    policy: String,
+    rules: PathBuf,
+    cost_model: PathBuf,
+}
+
+fn policy_name(policy: LevelPolicy) -> String {
+    clap::ValueEnum::to_possible_value(&policy).map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
 }
 
 #[derive(Args)]
@@ -507,7 +572,7 @@ fn positive_seconds(s: &str) -> Result<f64, String> {
     }
 }
 
-fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
+fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran: &WhatRan) {
     fn join<K: Key, T: std::fmt::Display + Copy>(counts: &Counts<K, T>) -> String {
         counts
             .iter()
@@ -520,6 +585,12 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig) {
         args.scenario.scenario.display(),
         s.seed,
         s.creatures
+    );
+    println!(
+        "level policy {} (rules {}, cost model {})",
+        ran.policy,
+        ran.rules.display(),
+        ran.cost_model.display()
     );
     println!(
         "simulated {:.2} s in {:.3} s of wall time ({:.1}x real time); {} Hz ticks, {} Hz steering",
@@ -613,15 +684,7 @@ fn main() -> ExitCode {
         ),
         #[cfg(feature = "game")]
         Some(Command::Play(args)) => args.play(),
-        Some(Command::Run(args)) => args.scenario.load().map(|config| {
-            let seconds = args.seconds.unwrap_or(f64::from(config.scenario.duration_s));
-            let summary = headless::run(config.clone(), seconds);
-            if args.json {
-                println!("{}", serde_json::to_string(&summary).expect("a summary serialises"));
-            } else {
-                print_summary(&args, &summary, &config);
-            }
-        }),
+        Some(Command::Run(args)) => args.run(),
         Some(Command::RecordGait(args)) => args.run(),
         Some(Command::Bench(args)) => args.run(),
         Some(Command::Experiment(ExperimentArgs { which })) => match which {

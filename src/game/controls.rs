@@ -135,7 +135,7 @@ fn read_game_keys(
             base.rules.budget.frame_budget_ms = budget;
             say(format!(
                 "frame budget {budget:.1} ms{}",
-                if config.scenario.level_policy == LevelPolicy::Budget {
+                if config.scenario.level_policy.uses_frame_budget() {
                     String::new()
                 } else {
                     format!(
@@ -172,8 +172,8 @@ impl Radius {
 
     fn used_by(self, policy: LevelPolicy) -> bool {
         match self {
-            Radius::Puck => matches!(policy, LevelPolicy::Influence | LevelPolicy::Combined),
-            Radius::Camera => matches!(policy, LevelPolicy::Camera | LevelPolicy::Combined),
+            Radius::Puck => policy.uses_puck_radius(),
+            Radius::Camera => policy.uses_camera_radius(),
         }
     }
 }

@@ -134,6 +134,21 @@ pub enum LevelPolicy {
 }
 
 impl LevelPolicy {
+    /// Whether the policy reads the puck's radius of influence (figure 8).
+    pub fn uses_puck_radius(self) -> bool {
+        matches!(self, Self::Influence | Self::Combined)
+    }
+
+    /// Whether the policy reads the camera's radius of influence (figure 9).
+    pub fn uses_camera_radius(self) -> bool {
+        matches!(self, Self::Camera | Self::Combined)
+    }
+
+    /// Whether the policy reads the frame budget.
+    pub fn uses_frame_budget(self) -> bool {
+        self == Self::Budget
+    }
+
     /// Whether levels change during a game under this policy.
     pub fn is_dynamic(self) -> bool {
         matches!(

@@ -42,6 +42,10 @@ fn run_json_has_the_keys_of_the_summary() {
         assert!(summary["collisions"][kind].is_u64(), "{summary}");
     }
     assert_eq!(summary["seed"], 3);
+    // It names what ran: the policy, its rules and its cost model.
+    assert_eq!(summary["policy"], "influence");
+    assert_eq!(summary["rules"], "assets/rules/levels.ron");
+    assert_eq!(summary["cost_model"], "assets/costs.ron");
     assert!((summary["sim_seconds"].as_f64().unwrap() - 2.0).abs() < 1e-9);
     let total = |key: &str| -> u64 {
         summary[key]
@@ -148,6 +152,19 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
     refused(&["run", "--puck-radius", "-3"], "between 0 and 10000 metres, got -3");
     refused(&["run", "--frame-budget", "-1"], "10000 ms");
     refused(&["run", "--seconds", "-2"], "more than 0");
+    // A flag the run's policy never reads is refused, not ignored.
+    refused(
+        &["run", "--policy", "combined", "--frame-budget", "1"],
+        "--frame-budget does not apply to the combined policy",
+    );
+    refused(
+        &["run", "--policy", "camera", "--puck-radius", "3"],
+        "--puck-radius does not apply to the camera policy",
+    );
+    refused(
+        &["run", "--policy", "influence", "--camera-radius", "3"],
+        "--camera-radius does not apply",
+    );
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["play", "--frame-budget=-1"], "10000 ms");
