@@ -714,7 +714,7 @@ fn finish(
             ..Panel::default()
         }])
         .collect();
-    plot::draw(&out.join("budget.png"), 3000, 600, &panels)?;
+    plot::draw(&out.join("budget.png"), 3000, 600, &panels, options.quick)?;
     let mut report = format!(
         "The budget policy (beyond the paper) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
@@ -788,6 +788,7 @@ fn finish(
             summary
         },
         report,
+        smoke_test: options.quick,
     }
     .finish(out, &csv)
 }

@@ -116,6 +116,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             ],
             ..Panel::default()
         }],
+        options.quick,
     )?;
     let at = |p: f64| points.iter().find(|q| q.0 == p).map(|q| q.1);
     let mut report = format!(
@@ -142,6 +143,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         command: command("fig7", options),
         summary: serde_json::json!({ "creatures_30fps": points, "paper": PAPER_ENDS, "trials": n_trials }),
         report,
+        smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
 }

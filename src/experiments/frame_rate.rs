@@ -195,6 +195,7 @@ pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Re
                 ..Panel::default()
             },
         ],
+        options.quick,
     )?;
     let creatures = config.scenario.creature_count();
     let mut report = format!(
@@ -243,6 +244,7 @@ pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Re
         command: command(name, options),
         summary: serde_json::json!({ "points": summary, "trials": n_trials, "seconds": s.seconds }),
         report,
+        smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
 }

@@ -199,6 +199,9 @@ pub struct ExperimentRecord {
     pub summary: serde_json::Value,
     /// Markdown: what the paper reports, what we measured, how they compare.
     pub report: String,
+    /// A `--quick` run: small counts and short games that check the pipeline, not findings.
+    #[serde(default)]
+    pub smoke_test: bool,
 }
 
 impl ExperimentRecord {

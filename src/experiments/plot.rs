@@ -107,13 +107,23 @@ fn tidy(x: f64) -> String {
     if s == "-0" { "0".into() } else { s.into() }
 }
 
-/// Draws `panels` side by side into a PNG of `width` by `height` pixels.
-pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel]) -> Result<(), String> {
+/// The banner over a smoke test's plot: its figures are not findings.
+pub const SMOKE_TEST_BANNER: &str = "SMOKE TEST (--quick): checks the pipeline; not a result";
+
+/// Draws `panels` side by side into a PNG of `width` by `height` pixels; a `smoke_test`'s
+/// plot says so in a banner over them.
+pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel], smoke_test: bool) -> Result<(), String> {
     register();
     let fail = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
-    for (area, panel) in root.split_evenly((1, panels.len().max(1))).iter().zip(panels) {
+    let area = if smoke_test {
+        let banner = ("sans-serif", TITLE_PT).into_font().color(&RED);
+        root.titled(SMOKE_TEST_BANNER, banner).map_err(|e| fail(&e))?
+    } else {
+        root.clone()
+    };
+    for (area, panel) in area.split_evenly((1, panels.len().max(1))).iter().zip(panels) {
         draw_panel(area, panel).map_err(|e| fail(&e))?;
     }
     root.present().map_err(|e| fail(&e))

@@ -24,9 +24,16 @@ pub fn write(out: &Path) -> Result<PathBuf, String> {
         };
         let record: ExperimentRecord =
             serde_json::from_str(&json).map_err(|e| format!("{}: not an experiment record: {e}", path.display()))?;
+        let smoke_test = if record.smoke_test {
+            "**Smoke test** (`--quick`): small counts and short games that check the pipeline runs. \
+             Its numbers are not findings, and no sentence below is a conclusion.\n\n"
+        } else {
+            ""
+        };
         let _ = write!(
             text,
-            "\n## {name}\n\n![{name}]({name}.png)\n\n`{}`\n\n{}\n",
+            "\n## {name}{}\n\n{smoke_test}![{name}]({name}.png)\n\n`{}`\n\n{}\n",
+            if record.smoke_test { " (smoke test)" } else { "" },
             record.command,
             record.report.trim_end()
         );

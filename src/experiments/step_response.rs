@@ -192,6 +192,7 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
              \"even small differences in velocity can result in substantial changes in final position\". After {:.1} s ours end {apart:.2} m apart.\n",
             experiment.duration_s
         ),
+        smoke_test: false,
     };
     summary += &record.save(out, &["step-response.png"])?;
     Ok(summary)
@@ -250,5 +251,6 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
                 ..Panel::default()
             },
         ],
+        false,
     )
 }

@@ -170,6 +170,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             series,
             notes: vec![],
         }],
+        options.quick,
     )?;
     let cell = |c: Option<[f64; 2]>, m: usize| c.map_or("-".to_string(), |c| format!("{:.5}", c[m]));
     let ratio = |ms: &KindCosts, m: usize, cheap: usize| match (ms[2], ms[cheap]) {
@@ -237,6 +238,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         command: command("table1", options),
         summary,
         report,
+        smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
 }

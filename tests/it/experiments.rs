@@ -156,6 +156,7 @@ fn every_experiment_quick_writes_its_files_and_a_plot_that_is_not_blank() {
         let record: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join(format!("{name}.json"))).unwrap()).unwrap();
         assert_eq!(record["experiment"], name);
+        assert_eq!(record["smoke_test"], true, "a quick {name} says it is a smoke test");
     }
     let report = std::fs::read_to_string(out.join("report.md")).unwrap();
     for name in ["table1", "fig7", "fig8", "fig9", "fig10"] {
@@ -163,7 +164,12 @@ fn every_experiment_quick_writes_its_files_and_a_plot_that_is_not_blank() {
             report.contains(&format!("![{name}]({name}.png)")),
             "report.md shows {name}"
         );
+        assert!(
+            report.contains(&format!("## {name} (smoke test)")),
+            "report.md marks the quick {name} as a smoke test"
+        );
     }
+    assert!(!report.contains("at no radius"), "a smoke test draws no conclusion");
     assert!(
         report.contains("2.4") && report.contains("112"),
         "the paper's numbers: {report}"
