@@ -2,7 +2,7 @@
 //! measurements.
 
 use clap::{Args, Parser, Subcommand};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use simlod::config::{
@@ -124,11 +124,16 @@ impl RecordGaitArgs {
         }
         let table = record(&config, &def.name, &settings)?;
         let speeds: Vec<String> = speeds.iter().map(f32::to_string).collect();
-        let command = format!(
+        // The files are found again from the command alone: the assets folder where it is not
+        // the default, and the scenario where one was given.
+        let mut command = format!(
             "simlod record-gait --creature {} --speeds {}",
             self.creature.display(),
             speeds.join(",")
         );
+        if self.scenario.assets != Path::new("assets") || self.scenario.scenario.is_some() {
+            command += &format!(" {}", self.scenario.file_flags());
+        }
         // A table the loader would refuse is not written: the old one stays.
         let mut check = Validator::default();
         table.validate(&mut check);
@@ -231,7 +236,7 @@ impl ExperimentRun {
             ),
             shard: self.shard.unwrap_or(experiments::Shard::WHOLE),
             assets: self.scenario.assets.clone(),
-            scenario: self.scenario.scenario.clone(),
+            scenario: self.scenario.scenario_file(),
         };
         let names: Vec<&str> = if name == "all" {
             if self.experiment.is_some() {
@@ -254,10 +259,12 @@ impl ExperimentRun {
 
 #[derive(Args)]
 struct ScenarioArgs {
-    /// The scenario file.
-    #[arg(long, default_value = "assets/scenarios/default.ron")]
-    scenario: PathBuf,
-    /// The assets folder the scenario's arena and creature kinds are found in.
+    /// The scenario file (default: scenarios/default.ron in the assets folder); a relative
+    /// path not found as given is looked up in the assets folder.
+    #[arg(long)]
+    scenario: Option<PathBuf>,
+    /// The assets folder: the default scenario, and the files every scenario names (arena,
+    /// rules, cost model, creature kinds, gait tables).
     #[arg(long, default_value = "assets")]
     assets: PathBuf,
     /// Overrides the scenario's seed.
@@ -301,7 +308,34 @@ fn frame_budget_ms(s: &str) -> Result<f32, String> {
     up_to_ten_thousand(s, "ms")
 }
 
+/// The scenario file a command reads: `scenario` as given, or, if a relative path is not found
+/// there, the same path in the assets folder; without one, the assets folder's default.
+fn scenario_file(assets: &Path, scenario: Option<&Path>) -> PathBuf {
+    match scenario {
+        None => assets.join(DEFAULT_SCENARIO),
+        Some(path) if path.is_relative() && !path.exists() && assets.join(path).exists() => assets.join(path),
+        Some(path) => path.to_path_buf(),
+    }
+}
+
+/// The scenario every command runs without `--scenario`, in the assets folder.
+const DEFAULT_SCENARIO: &str = "scenarios/default.ron";
+
 impl ScenarioArgs {
+    fn scenario_file(&self) -> PathBuf {
+        scenario_file(&self.assets, self.scenario.as_deref())
+    }
+
+    /// The flags that find these files again from anywhere: `--assets`, and `--scenario`
+    /// where it is not the default.
+    fn file_flags(&self) -> String {
+        let mut flags = format!("--assets {}", self.assets.display());
+        if let Some(scenario) = &self.scenario {
+            flags += &format!(" --scenario {}", scenario.display());
+        }
+        flags
+    }
+
     fn what_ran(&self, config: &SimConfig) -> WhatRan {
         WhatRan {
             policy: policy_name(config.scenario.level_policy),
@@ -320,7 +354,8 @@ impl ScenarioArgs {
     /// The scenario with its overrides, without what is about to be measured anew (see
     /// [`SimConfig::load_measuring`]).
     fn load_measuring(&self, anew: MeasuredAnew) -> Result<SimConfig, String> {
-        let mut config = SimConfig::load_measuring(&self.scenario, &self.assets, anew).map_err(|e| e.to_string())?;
+        let mut config =
+            SimConfig::load_measuring(&self.scenario_file(), &self.assets, anew).map_err(|e| e.to_string())?;
         if let Some(rules) = &self.rules {
             config.rules = load_file(rules).map_err(|e| e.to_string())?;
             if !anew.cost_model {
@@ -353,9 +388,11 @@ impl ScenarioArgs {
 #[cfg(feature = "game")]
 #[derive(Parser)]
 struct PlayArgs {
-    /// The scenario file; it must be inside the assets folder, which the game watches.
-    #[arg(long, default_value = "assets/scenarios/default.ron")]
-    scenario: PathBuf,
+    /// The scenario file (default: scenarios/default.ron in the assets folder); it must be
+    /// inside the assets folder, which the game watches. A relative path not found as given
+    /// is looked up in the assets folder.
+    #[arg(long)]
+    scenario: Option<PathBuf>,
     /// The assets folder: the scenario's arena and creature kinds, and `game.ron`.
     #[arg(long, default_value = "assets")]
     assets: PathBuf,
@@ -382,7 +419,7 @@ struct PlayArgs {
 impl PlayArgs {
     fn play(self) -> Result<(), String> {
         simlod::game::play(simlod::game::PlayOptions {
-            scenario: self.scenario,
+            scenario: scenario_file(&self.assets, self.scenario.as_deref()),
             assets: self.assets,
             policy: self.policy,
             frame_budget_ms: self.frame_budget,
@@ -524,8 +561,8 @@ impl BenchArgs {
             .as_ref()
             .map(|r| format!(" --rules {}", r.display()));
         let command = format!(
-            "simlod bench --calibrate --scenario {}{}{}",
-            self.scenario.scenario.display(),
+            "simlod bench --calibrate {}{}{}",
+            self.scenario.file_flags(),
             rules.unwrap_or_default(),
             if self.quick { " --quick" } else { "" }
         );
@@ -582,7 +619,7 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran: &WhatRan)
     }
     println!(
         "simlod run: {}, seed {}, {} creatures",
-        args.scenario.scenario.display(),
+        args.scenario.scenario_file().display(),
         s.seed,
         s.creatures
     );

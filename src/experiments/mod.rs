@@ -306,7 +306,10 @@ pub fn stand(world: &mut World, entity: Entity, position: Vec2, heading: Option<
 /// The command line that reruns experiment `name` as `options` ran it.
 pub fn command(name: &str, options: &Options) -> String {
     let mut c = format!("simlod experiment {name} --out {}", options.out.display());
-    if options.scenario != Path::new("assets/scenarios/default.ron") {
+    if options.assets != Path::new("assets") {
+        c += &format!(" --assets {}", options.assets.display());
+    }
+    if options.scenario != options.assets.join("scenarios/default.ron") {
         c += &format!(" --scenario {}", options.scenario.display());
     }
     if options.quick {

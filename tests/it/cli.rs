@@ -248,3 +248,49 @@ fn the_budget_line_says_when_the_measured_frame_is_over_the_budget() {
     assert!(line.contains("over it at 30 of 30 decisions"), "{line}");
     assert!(line.contains("% over the budget") && !line.contains("within"), "{line}");
 }
+
+#[test]
+fn assets_moves_everything_the_default_scenario_included_and_scenarios_are_found_inside_it() {
+    let assets = crate::support::copy_assets("assets_moves_everything");
+    // The copy's default game has 7 hoppers: a run that read the repository's would have 40.
+    let default = std::fs::read_to_string(assets.join("scenarios/default.ron")).unwrap();
+    let seven = default
+        .replace("(kind: \"hopper\", count: 30)", "(kind: \"hopper\", count: 7)")
+        .replace("(kind: \"biped\", count: 10),", "");
+    assert_ne!(seven, default, "the default scenario names its groups");
+    std::fs::write(assets.join("scenarios/default.ron"), seven).unwrap();
+    let elsewhere = std::env::temp_dir();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_simlod"))
+            .args(args)
+            .current_dir(&elsewhere)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let dir = assets.to_str().unwrap();
+    let summary = run(&["run", "--assets", dir, "--seconds", "1", "--json"]);
+    assert_eq!(
+        summary["creatures"], 7,
+        "run outside the repository, on the copy's default game"
+    );
+    let summary = run(&[
+        "run",
+        "--assets",
+        dir,
+        "--scenario",
+        "scenarios/hoppers.ron",
+        "--seconds",
+        "1",
+        "--json",
+    ]);
+    assert_eq!(summary["rules"], format!("{dir}/rules/levels.ron"));
+    let hoppers: simlod::config::Scenario = simlod::config::load_file(&assets.join("scenarios/hoppers.ron")).unwrap();
+    let count: u32 = hoppers.creatures.iter().map(|g| g.count).sum();
+    assert_eq!(summary["creatures"], count, "--scenario is looked up in --assets");
+}
