@@ -13,10 +13,11 @@ pub struct ArenaConfig {
     pub court_length_m: f32,
     /// Inside width of the court along z; 1 to 10,000 m.
     pub court_width_m: f32,
-    /// 0.1 to 100 m.
+    /// Height of the walls; 0.1 to 100 m.
     pub wall_height_m: f32,
-    /// 0.01 to 100 m.
+    /// Thickness of the walls; 0.01 to 100 m.
     pub wall_thickness_m: f32,
+    /// The giant puck.
     pub puck: PuckConfig,
     /// A respawned creature starts at least this far from the puck's rim when it can; 0 to
     /// 10,000 m.

@@ -31,7 +31,9 @@ pub struct CostModel {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct KindCosts {
+    /// The creature kind, as named in a scenario.
     pub kind: String,
+    /// Its costs at each level.
     pub costs: LevelCosts,
 }
 
@@ -41,9 +43,13 @@ pub struct KindCosts {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LevelCosts {
+    /// At the point-mass level.
     pub point_mass_us_per_frame: f32,
+    /// At the hybrid level.
     pub hybrid_us_per_frame: f32,
+    /// At the rigid level.
     pub rigid_us_per_frame: f32,
+    /// Once, for a switch into the rigid level.
     pub switch_to_rigid_us: f32,
 }
 

@@ -1,6 +1,6 @@
 //! A creature definition: `assets/creatures/<kind>.ron`.
 
-use super::{Validate, Validator};
+use super::{Validate, Validator, number};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -14,6 +14,7 @@ pub const MAX_LEGS: usize = 4;
 pub struct CreatureDef {
     /// The kind's name; must match the file name (`creatures/<name>.ron`).
     pub name: String,
+    /// The body: its footprint, standing height and mass.
     pub body: BodyConfig,
     /// Planar speed limit. A kind with a gait table moves its point mass (hybrid and point-mass
     /// levels) at the table's measured limits instead (paper 3.2). 0.01 to 50 m/s.
@@ -35,6 +36,7 @@ pub struct CreatureDef {
     /// Share of the normal impact speed kept after a point-mass collision (0 = dead stop); 0
     /// to 1.
     pub collision_restitution: f32,
+    /// How it chooses where to go.
     pub steering: SteeringConfig,
     /// The legs (at least one, at most [`MAX_LEGS`]): drawn at every level, simulated at the
     /// rigid one.
@@ -57,27 +59,27 @@ pub struct CreatureDef {
 pub struct LegConfig {
     /// Where the hip sits, from the body's centre: x forward, y up, z to the right; -5 to 5 m.
     pub hip_m: (f32, f32, f32),
-    /// 0.02 to 5 m.
+    /// Length of the upper leg; 0.02 to 5 m.
     pub upper_length_m: f32,
-    /// 0.01 to 1000 kg.
+    /// Mass of the upper leg; 0.01 to 1000 kg.
     pub upper_mass_kg: f32,
-    /// Foot included; 0.02 to 5 m.
+    /// Length of the lower leg, foot included; 0.02 to 5 m.
     pub lower_length_m: f32,
-    /// 0.01 to 1000 kg.
+    /// Mass of the lower leg; 0.01 to 1000 kg.
     pub lower_mass_kg: f32,
-    /// 0.002 to 0.5 m.
+    /// Radius of the leg's parts; 0.002 to 0.5 m.
     pub radius_m: f32,
-    /// 0.005 to 0.5 m.
+    /// Radius of the ball foot; 0.005 to 0.5 m.
     pub foot_radius_m: f32,
-    /// 0 to 10.
+    /// Friction coefficient of the foot on the ground; 0 to 10.
     pub foot_friction: f32,
     /// Hip to foot centre with the spring at rest; 0.05 to 10 m.
     pub rest_length_m: f32,
     /// Hip to foot centre at the joint's stop; 0.02 to 10 m, below the rest length.
     pub min_length_m: f32,
-    /// 1 to 1e6 N/m.
+    /// Stiffness of the leg spring; 1 to 1e6 N/m.
     pub spring_n_per_m: f32,
-    /// 0 to 1e5 N s/m.
+    /// Damping of the leg spring; 0 to 1e5 N s/m.
     pub damping_n_s_per_m: f32,
 }
 
@@ -112,6 +114,7 @@ pub struct RigidConfig {
     /// Gains and limits: times 0.01 to 5 s, thrusts 0 to 1 m, gains `*_kp_*` 0 to 1e5 and
     /// `*_kd_*` 0 to 1e4, torques 0 to 1e4 N m, speeds 0 to 50 m/s, as each field says.
     pub controller: RaibertConfig,
+    /// When it has fallen.
     pub fall: FallConfig,
     /// How rapier joins the bodies: `Impulse` (the default) or `Multibody`.
     #[serde(default)]
@@ -139,6 +142,7 @@ pub struct RaibertConfig {
     pub flight_time_s: f32,
     /// Extra spring extension during thrust, at the start.
     pub thrust_initial_m: f32,
+    /// Largest extra spring extension during thrust.
     pub thrust_max_m: f32,
     /// Thrust change per second of flight-time error, once a hop.
     pub thrust_gain_m_per_s: f32,
@@ -151,12 +155,15 @@ pub struct RaibertConfig {
     pub max_foot_offset_fraction: f32,
     /// Flight: hip torque swinging the leg to the foot placement angle.
     pub swing_kp_nm_per_rad: f32,
+    /// Flight: damping of the leg's swing.
     pub swing_kd_nm_s_per_rad: f32,
     /// Stance: hip torque holding the body level (pitch and roll).
     pub attitude_kp_nm_per_rad: f32,
+    /// Stance: damping of the body's pitch and roll.
     pub attitude_kd_nm_s_per_rad: f32,
     /// Stance: torque turning the body to its heading, through the foot's grip.
     pub yaw_kp_nm_per_rad: f32,
+    /// Stance: damping of the body's turn.
     pub yaw_kd_nm_s_per_rad: f32,
     /// Largest yaw torque the foot's grip on the ground can take.
     pub yaw_max_torque_nm: f32,
@@ -188,6 +195,7 @@ pub struct FallConfig {
     pub blow_up_speed_m_per_s: f32,
 }
 
+/// The body every level shares (paper 3.3: the point mass is this body alone).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodyConfig {
@@ -195,7 +203,7 @@ pub struct BodyConfig {
     pub radius_m: f32,
     /// Height of the hip above the ground while standing; 0.01 to 20 m.
     pub hip_height_m: f32,
-    /// 0.01 to 10,000 kg.
+    /// Mass of the body, legs not included; 0.01 to 10,000 kg.
     pub mass_kg: f32,
 }
 
@@ -212,13 +220,16 @@ pub struct SteeringConfig {
     pub puck_alert_distance_m: f32,
     /// How far ahead the puck's path is predicted; 0 to 60 s.
     pub puck_lookahead_s: f32,
+    /// Weight of fleeing the puck's path.
     pub puck_weight: f32,
     /// Walls repel within this distance; 0 to 10,000 m.
     pub wall_avoid_distance_m: f32,
+    /// Weight of turning away from a wall.
     pub wall_weight: f32,
     /// Other creatures repel within this distance (centre to centre); 0 to 100 m: the
     /// neighbour grid's cells are this big.
     pub separation_distance_m: f32,
+    /// Weight of keeping apart from other creatures.
     pub separation_weight: f32,
 }
 
@@ -258,8 +269,17 @@ impl Validate for CreatureDef {
         for (i, leg) in self.legs.iter().enumerate() {
             v.nested(&format!("legs[{i}]"), |v| leg.validate(v));
         }
+        self.validate_relations(v);
         if let Some(r) = &self.rigid {
             v.nested("rigid", |v| r.validate_on(&self.legs, v));
+            v.require(
+                r.fall.body_min_height_m < self.body.hip_height_m || not_finite(&[r.fall.body_min_height_m, self.body.hip_height_m]),
+                "rigid.fall.body_min_height_m",
+                format!(
+                    "must be below body.hip_height_m ({} m): a creature standing lower than its fall height has fallen",
+                    number(self.body.hip_height_m)
+                ),
+            );
         }
         let s = &self.steering;
         v.nested("steering", |v| {
@@ -279,6 +299,60 @@ impl Validate for CreatureDef {
             );
         });
     }
+}
+
+impl CreatureDef {
+    /// Numbers that are each in range but together describe a creature that cannot exist:
+    /// each rule names both fields. A NaN or infinity was reported by its range check.
+    fn validate_relations(&self, v: &mut Validator) {
+        v.require(
+            self.stance != Stance::Alternating || self.legs.len() >= 2,
+            "stance",
+            format!("Alternating takes turns between legs: it needs at least 2, and legs has {}", self.legs.len()),
+        );
+        let body = &self.body;
+        for (i, leg) in self.legs.iter().enumerate() {
+            let reach = leg.upper_length_m + leg.lower_length_m;
+            v.require(
+                leg.rest_length_m <= reach || not_finite(&[leg.rest_length_m, reach]),
+                &format!("legs[{i}].rest_length_m"),
+                format!(
+                    "{} m is beyond what the leg's parts reach end to end: upper_length_m + lower_length_m = {} m",
+                    number(leg.rest_length_m),
+                    number(reach)
+                ),
+            );
+            let (x, y, z) = leg.hip_m;
+            let hip_height = body.hip_height_m + y;
+            v.require(
+                (leg.min_length_m..=reach).contains(&hip_height) || not_finite(&[hip_height, reach, leg.min_length_m]),
+                "body.hip_height_m",
+                format!(
+                    "standing at {} m puts leg {i}'s hip {} m above the ground (with legs[{i}].hip_m.1), where the leg cannot stand: it is between legs[{i}].min_length_m ({} m) and its parts end to end ({} m)",
+                    number(body.hip_height_m),
+                    number(hip_height),
+                    number(leg.min_length_m),
+                    number(reach)
+                ),
+            );
+            let out = x.hypot(z);
+            v.require(
+                out <= body.radius_m || not_finite(&[out, body.radius_m]),
+                &format!("legs[{i}].hip_m"),
+                format!(
+                    "the hip is {} m from the body's centre across the ground, outside body.radius_m ({} m)",
+                    number(out),
+                    number(body.radius_m)
+                ),
+            );
+        }
+    }
+}
+
+/// A relation between numbers is not checked where one of them is not a number: its own range
+/// check has reported it.
+fn not_finite(values: &[f32]) -> bool {
+    values.iter().any(|x| !x.is_finite())
 }
 
 impl Validate for LegConfig {
@@ -318,6 +392,17 @@ impl RigidConfig {
             v.range(&format!("body_half_extents_m.{i}"), e, 0.01, 5.0);
         }
         for (i, leg) in legs.iter().enumerate() {
+            let (hx, hy, hz) = leg.hip_m;
+            v.require(
+                (hx.abs() <= x && hy.abs() <= y && hz.abs() <= z) || not_finite(&[hx, hy, hz, x, y, z]),
+                "body_half_extents_m",
+                format!(
+                    "leg {i}'s hip (legs[{i}].hip_m: {}, {}, {}) is outside the body box it hangs from",
+                    number(hx),
+                    number(hy),
+                    number(hz)
+                ),
+            );
             v.require(
                 leg.lower_length_m + y < leg.min_length_m,
                 "body_half_extents_m.1",

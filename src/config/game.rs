@@ -10,19 +10,28 @@ use std::collections::BTreeMap;
 /// A colour as sRGB components in `[0, 1]`.
 pub type Srgb = [f32; 3];
 
+/// The game's looks and feel: `assets/game.ron`.
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GameConfig {
+    /// The player's view.
     pub camera: CameraConfig,
+    /// The overhead view of the court.
     pub inset: InsetConfig,
     /// The colour of each level of detail (paper figures 5 and 6: rigid yellow, hybrid blue);
     /// every level needs one.
     pub level_colours_srgb: BTreeMap<Lod, Srgb>,
+    /// The colours of everything but the creatures' bodies.
     pub scene_colours: SceneColours,
+    /// How the puck is drawn.
     pub puck_look: PuckLook,
+    /// The sun and the fill light.
     pub lighting: LightingConfig,
+    /// The text over the game.
     pub hud: HudConfig,
+    /// How creatures are drawn.
     pub creature_look: CreatureLook,
+    /// How `--record` writes its animated picture.
     pub recording: RecordingConfig,
 }
 
@@ -33,7 +42,7 @@ pub struct GameConfig {
 pub struct CameraConfig {
     /// How far behind the player the camera sits, away from the puck; 0.1 to 1000 m.
     pub follow_distance_m: f32,
-    /// 0.1 to 1000 m.
+    /// Height of the camera above the ice; 0.1 to 1000 m.
     pub follow_height_m: f32,
     /// Where the camera aims: 0 at the player, 1 at the puck.
     pub aim_toward_puck_fraction: f32,
@@ -42,6 +51,7 @@ pub struct CameraConfig {
     pub aim_height_m: f32,
     /// How fast the camera catches up with where it wants to be; 0.01 to 1000 per second.
     pub follow_rate_per_s: f32,
+    /// Vertical field of view.
     pub field_of_view_deg: f32,
 }
 
@@ -63,14 +73,21 @@ pub struct InsetConfig {
     pub view_cone_opacity: f32,
 }
 
+/// Colours of the scene, each sRGB in `[0, 1]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneColours {
+    /// The sky, behind everything.
     pub sky_srgb: Srgb,
+    /// The ice of the court.
     pub floor_srgb: Srgb,
+    /// The lines drawn on the ice.
     pub court_lines_srgb: Srgb,
+    /// The walls.
     pub wall_srgb: Srgb,
+    /// The puck and the wedge ahead of it.
     pub puck_srgb: Srgb,
+    /// Every creature's legs.
     pub leg_srgb: Srgb,
     /// Creature bodies when colouring by level is off.
     pub uncoloured_srgb: Srgb,
@@ -85,13 +102,15 @@ pub struct PuckLook {
     /// A wedge on the ice ahead of the puck points where it goes; its tip is where the puck's
     /// front will be this long from now (0 hides it).
     pub path_ahead_s: f32,
+    /// Opacity of the wedge; 0 to 1.
     pub path_opacity: f32,
 }
 
+/// The light of the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LightingConfig {
-    /// 0 to 200,000 lux.
+    /// Brightness of the sunlight; 0 to 200,000 lux.
     pub sun_illuminance_lux: f32,
     /// Height of the sun above the horizon.
     pub sun_elevation_deg: f32,
@@ -103,9 +122,11 @@ pub struct LightingConfig {
     pub shadow_distance_m: f32,
 }
 
+/// The text over the game.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HudConfig {
+    /// Size of the HUD's text.
     pub font_size_px: f32,
     /// The game-over banner.
     pub banner_font_size_px: f32,
@@ -123,11 +144,11 @@ pub struct HudConfig {
 pub struct CreatureLook {
     /// Body radius as a share of the creature's footprint radius (`body.radius_m`).
     pub body_radius_fraction: f32,
-    /// The body is an ellipsoid: its length (along the heading) and height as shares of
-    /// its width.
+    /// The body is an ellipsoid: its length (along the heading) as a share of its width.
     pub body_length_ratio: f32,
+    /// The body's height as a share of its width.
     pub body_height_ratio: f32,
-    /// 0.001 to 1 m.
+    /// Thickness of the legs as drawn; 0.001 to 1 m.
     pub leg_thickness_m: f32,
     /// A nose at the front of the body shows which way a creature faces: its radius as a
     /// share of the body's.

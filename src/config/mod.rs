@@ -35,12 +35,15 @@ use std::path::{Path, PathBuf};
 /// Everything one simulation run is built from: the scenario and the files it names.
 #[derive(Resource, Clone, Debug)]
 pub struct SimConfig {
+    /// The scenario file.
     pub scenario: Scenario,
+    /// The court and puck it names.
     pub arena: ArenaConfig,
     /// Creature definitions, indexed by [`crate::creature::Creature::kind`].
     pub kinds: Vec<CreatureDef>,
     /// Each kind's gait table, if it has one (same index as `kinds`).
     pub gaits: Vec<Option<GaitTable>>,
+    /// The level rules it names.
     pub rules: LevelRules,
     /// The budget policy's cost model (the file the rules' `budget.cost_model` names).
     pub costs: CostModel,
@@ -50,7 +53,9 @@ pub struct SimConfig {
 /// table, `simlod bench --calibrate` the cost model (which starts empty).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct MeasuredAnew<'a> {
+    /// The kind whose gait table is about to be recorded.
     pub gait_table_of: Option<&'a str>,
+    /// Whether the cost model is about to be calibrated.
     pub cost_model: bool,
 }
 

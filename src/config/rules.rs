@@ -4,10 +4,13 @@ use super::{Validate, Validator};
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// The rules that choose each creature's level of detail: `assets/rules/levels.ron`.
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LevelRules {
+    /// Areas of influence around the puck, the walls and the creatures.
     pub influence: InfluenceRules,
+    /// The camera's view.
     pub camera: CameraRules,
     /// To leave an area a creature must be this much further out than to enter it; 0 to 1000 m.
     pub release_margin_m: f32,
@@ -29,13 +32,13 @@ pub struct LevelRules {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct InfluenceRules {
-    /// 0 to 10,000 m.
+    /// The puck's radius of influence, beyond its rim; 0 to 10,000 m.
     pub puck_radius_m: f32,
-    /// 0 to 1000 m.
+    /// A creature's radius of influence on the others; 0 to 1000 m.
     pub creature_radius_m: f32,
-    /// 0 to 60 s.
+    /// Each area is stretched along its body's velocity to cover where it will be this long from now; 0 to 60 s.
     pub lookahead_s: f32,
-    /// 0 to 10,000 m.
+    /// A wall's area: the band this wide along it; 0 to 10,000 m.
     pub wall_band_m: f32,
 }
 
@@ -43,11 +46,11 @@ pub struct InfluenceRules {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CameraRules {
-    /// 0 to 10,000 m.
+    /// The camera's radius of influence: in view and nearer than this, rigid; 0 to 10,000 m.
     pub radius_m: f32,
-    /// 1 to 179 degrees.
+    /// Opening angle of the view cone; 1 to 179 degrees.
     pub field_of_view_deg: f32,
-    /// 0 to 1000 m.
+    /// Headless, the camera rides this far behind the creature it follows, facing the puck; 0 to 1000 m.
     pub follow_distance_m: f32,
 }
 
@@ -68,9 +71,11 @@ pub struct BudgetRules {
     /// The earliest contact possible (both turning toward each other at full speed) counts
     /// this much of a contact on the present course; 0 to 1.
     pub worst_case_share: f32,
-    /// Benefit of the rigid level for a contact now, by what it would be with: 0 to 1000 each.
+    /// Benefit of the rigid level for a contact now with the puck; 0 to 1000.
     pub puck_weight: f32,
+    /// ... with a wall; 0 to 1000.
     pub wall_weight: f32,
+    /// ... with another creature; 0 to 1000.
     pub creature_weight: f32,
     /// In view, the benefit of seeing a creature halves at this distance from the camera;
     /// 0.01 to 10,000 m.

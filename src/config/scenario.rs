@@ -5,6 +5,7 @@ use crate::lod::LevelPolicy;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// A scenario file, `assets/scenarios/<name>.ron`: what one run is made of.
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
@@ -20,18 +21,21 @@ pub struct Scenario {
     /// Rapier's solver iterations per tick, 1 to 16 (each is a substep of the tick; 8 when
     /// left out). Impulse joints hold the hopper's gait steady at its top speed from 8 (at
     /// rapier's default of 4 its hops vary by 10 %); a multibody's cost grows with them: see
-    /// the README's "The rigid level's cost".
+    /// docs/guide/performance.md.
     #[serde(default = "default_solver_iterations")]
     pub solver_iterations: u32,
     /// The arena file, relative to the assets folder and inside it.
     pub arena: String,
+    /// The creatures, by kind.
     pub creatures: Vec<CreatureGroup>,
+    /// How each creature's level of detail is chosen (paper 3.4).
     pub level_policy: LevelPolicy,
     /// The level rules file (relative to the assets folder and inside it): influence areas, camera rule,
     /// switching window.
     pub level_rules: String,
 }
 
+/// So many creatures of one kind.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CreatureGroup {
@@ -43,6 +47,7 @@ pub struct CreatureGroup {
 }
 
 impl Scenario {
+    /// Creatures in all groups.
     pub fn creature_count(&self) -> u32 {
         self.creatures.iter().map(|g| g.count).sum()
     }

@@ -8,17 +8,21 @@ use std::path::{Path, PathBuf};
 pub struct Problem {
     /// Dotted path of the field, e.g. `puck.mass_kg`; empty when the whole file is at fault.
     pub field: String,
+    /// What is wrong with it.
     pub message: String,
 }
 
 /// A file that could not be used, and every problem found in it. Never a panic.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConfigError {
+    /// The file.
     pub file: PathBuf,
+    /// What is wrong with it, field by field.
     pub problems: Vec<Problem>,
 }
 
 impl ConfigError {
+    /// An error of one problem with one field.
     pub fn one(file: &Path, field: impl Into<String>, message: impl Into<String>) -> Self {
         Self {
             file: file.to_path_buf(),
@@ -56,6 +60,7 @@ pub struct Validator {
 }
 
 impl Validator {
+    /// The file's error if any check failed.
     pub fn finish(self, file: &Path) -> Result<(), ConfigError> {
         if self.problems.is_empty() {
             Ok(())
@@ -74,6 +79,7 @@ impl Validator {
         self.prefix.pop();
     }
 
+    /// Records that `field` (under the nested struct being checked) is wrong.
     pub fn fail(&mut self, field: &str, message: impl Into<String>) {
         let mut path = self.prefix.join(".");
         if !field.is_empty() {
