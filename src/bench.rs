@@ -20,10 +20,12 @@ const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
 /// What `simlod bench --json` prints, one object per level.
 #[derive(Clone, Debug, Serialize)]
 pub struct LevelBench {
+    /// The level measured.
     #[serde(serialize_with = "level_name")]
     pub level: Lod,
     /// Median wall time per creature per 1/30 s of motion, at `reference_creatures`.
     pub us_per_creature_per_frame: f64,
+    /// The creature count the cost per creature was measured at.
     pub reference_creatures: u32,
     /// Median wall time of a whole frame at `reference_creatures`.
     pub frame_ms_median: f64,
@@ -62,6 +64,7 @@ pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig 
     c
 }
 
+/// The middle value (the upper one of an even count); `values` must not be empty.
 pub fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     values[values.len() / 2]

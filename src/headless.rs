@@ -16,6 +16,7 @@ use crate::{SimClock, SimPlugin};
 
 /// A headless simulation: `MinimalPlugins` plus the core, driven in fixed ticks.
 pub struct HeadlessSim {
+    /// The Bevy app: reach its world for anything the run holds.
     pub app: App,
     ticks_per_update: u32,
 }
@@ -44,6 +45,7 @@ impl HeadlessSim {
         Self { app, ticks_per_update }
     }
 
+    /// The simulation's clock now.
     pub fn clock(&self) -> SimClock {
         *self.app.world().resource::<SimClock>()
     }
@@ -66,6 +68,7 @@ impl HeadlessSim {
         }
     }
 
+    /// What the run did so far, as `simlod run` prints it; `wall_seconds` is the caller's measure.
     pub fn summary(&mut self, wall_seconds: f64) -> Summary {
         summarize(self.app.world_mut(), wall_seconds)
     }

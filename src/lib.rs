@@ -130,6 +130,7 @@ pub struct SimClock {
     pub tick: u64,
     /// Seconds per tick (1 / `tick_hz`).
     pub dt: f32,
+    /// Ticks per simulated second.
     pub tick_hz: u32,
     /// Ticks per steering decision (`tick_hz / decision_hz`).
     pub ticks_per_decision: u32,
@@ -146,6 +147,7 @@ impl SimClock {
         self.tick / u64::from(self.ticks_per_decision)
     }
 
+    /// Simulated seconds so far.
     pub fn seconds(&self) -> f64 {
         self.tick as f64 / f64::from(self.tick_hz)
     }
@@ -153,6 +155,7 @@ impl SimClock {
 
 /// The headless simulation core: add it to any `App` (the game's or a test's).
 pub struct SimPlugin {
+    /// The scenario, loaded and checked, with every file it names.
     pub config: SimConfig,
 }
 

@@ -33,8 +33,11 @@ pub struct Wall;
 /// The puck as every creature sees it this tick.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct PuckState {
+    /// Centre on the ground plane (world x, z), metres.
     pub position: Vec2,
+    /// Velocity on the ground plane, m/s.
     pub velocity: Vec2,
+    /// The puck's own radius.
     pub radius_m: f32,
 }
 

@@ -273,7 +273,8 @@ impl Validate for CreatureDef {
         if let Some(r) = &self.rigid {
             v.nested("rigid", |v| r.validate_on(&self.legs, v));
             v.require(
-                r.fall.body_min_height_m < self.body.hip_height_m || not_finite(&[r.fall.body_min_height_m, self.body.hip_height_m]),
+                r.fall.body_min_height_m < self.body.hip_height_m
+                    || not_finite(&[r.fall.body_min_height_m, self.body.hip_height_m]),
                 "rigid.fall.body_min_height_m",
                 format!(
                     "must be below body.hip_height_m ({} m): a creature standing lower than its fall height has fallen",
@@ -308,7 +309,10 @@ impl CreatureDef {
         v.require(
             self.stance != Stance::Alternating || self.legs.len() >= 2,
             "stance",
-            format!("Alternating takes turns between legs: it needs at least 2, and legs has {}", self.legs.len()),
+            format!(
+                "Alternating takes turns between legs: it needs at least 2, and legs has {}",
+                self.legs.len()
+            ),
         );
         let body = &self.body;
         for (i, leg) in self.legs.iter().enumerate() {

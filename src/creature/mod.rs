@@ -36,7 +36,9 @@ pub struct Creature {
 /// The body's state on the ground plane, shared by every level (plane x, y = world x, z).
 #[derive(Component, Clone, Copy, Debug, PartialEq)]
 pub struct PlanarState {
+    /// Metres, on the ground plane.
     pub position: Vec2,
+    /// Metres per second, on the ground plane.
     pub velocity: Vec2,
     /// Direction the body faces: a unit vector (an angle would cost an `atan2` per tick).
     pub heading: Vec2,
@@ -67,6 +69,7 @@ impl PlanarState {
 pub struct GaitPhase {
     /// Fraction of the step since the last touchdown, in `[0, 1)`.
     pub cycle: f32,
+    /// Whether every foot is off the ground (the flight phase: where a switch may happen).
     pub in_flight: bool,
     /// Simulated time of the last touchdown, s.
     pub last_touchdown_s: f32,
@@ -135,18 +138,23 @@ pub struct DesiredVelocity(pub Vec2);
 /// Per-kind constants, derived once from the creature files.
 #[derive(Clone, Debug)]
 pub struct KindParams {
+    /// The footprint's radius: the collision circle below the rigid level.
     pub radius_m: f32,
+    /// The whole creature's mass.
     pub mass_kg: f32,
     /// The point mass's limits: the gait table's measured ones when there is a table.
     pub top_speed_m_per_s: f32,
+    /// The point mass's acceleration limit (see `top_speed_m_per_s`).
     pub acceleration_limit_m_per_s2: f32,
     /// How fast the rigid model's command follows the desired velocity.
     pub command_acceleration_m_per_s2: f32,
+    /// How fast the body turns to face its course.
     pub turn_rate_rad_per_s: f32,
     /// Standing pose: the point-mass level holds it (the legs straight down).
     pub standing_pose: GaitPose,
     /// Where each leg's hip sits on the body (x forward, y up, z to the right).
     pub hips_m: Vec<Vec3>,
+    /// Each leg's parts, spring and foot, in the kind's order.
     pub legs: Vec<LegConfig>,
     /// Steps in a stride: the legs taking turns, or together.
     pub steps_per_stride: u32,
@@ -154,10 +162,15 @@ pub struct KindParams {
     pub cycles_per_s: f32,
     /// Part of the cycle before lift-off.
     pub stance_fraction: f32,
+    /// Below the rigid level, an impact with a greater normal speed is a fall.
     pub fall_impact_speed_m_per_s: f32,
+    /// Share of the approaching speed kept when a point mass bounces off something.
     pub collision_restitution: f32,
+    /// How this kind steers: wandering, fleeing the puck, avoiding walls and others.
     pub steering: SteeringConfig,
+    /// The rigid model and its controller, if the kind has the rigid level.
     pub rigid: Option<RigidConfig>,
+    /// The gait table, if the kind has the hybrid level.
     pub gait: Option<GaitTable>,
     /// The levels this kind has a model for, cheapest first.
     pub levels: Vec<Lod>,
@@ -174,6 +187,7 @@ impl KindParams {
             .unwrap_or(Lod::PointMass)
     }
 
+    /// A kind's constants from its file and its gait table (whose limits the point mass takes).
     pub fn new(d: &CreatureDef, gait: Option<&GaitTable>) -> Self {
         let hips_m: Vec<Vec3> = d.legs.iter().map(|l| Vec3::from(l.hip_m)).collect();
         let standing: Vec<LegPose> = hips_m
@@ -240,6 +254,7 @@ impl Index<usize> for KindTable {
 pub struct SerialCounter(pub u32);
 
 impl SerialCounter {
+    /// The next serial.
     pub fn take(&mut self) -> u32 {
         self.0 += 1;
         self.0 - 1

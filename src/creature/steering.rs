@@ -37,11 +37,17 @@ fn nearest_on_segment(p: Vec2, a: Vec2, b: Vec2) -> Vec2 {
 
 /// Everything steering reads besides the creature itself.
 pub struct Surroundings<'a> {
+    /// The puck now.
     pub puck: &'a PuckState,
+    /// The court's walls.
     pub court: &'a Court,
+    /// The creatures nearby.
     pub grid: &'a NeighbourGrid,
+    /// The world's seed: each creature's wandering is drawn from it, its serial and the decision.
     pub seed: u64,
+    /// Index of this steering decision.
     pub decision: u64,
+    /// Seconds between decisions.
     pub decision_dt: f32,
 }
 

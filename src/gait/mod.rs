@@ -42,6 +42,7 @@ pub struct LegPose {
     pub length_m: f32,
     /// Leg angle from vertical toward the body's front, and toward its left side.
     pub forward_rad: f32,
+    /// Leg angle from vertical toward the body's left side.
     pub sideways_rad: f32,
 }
 
@@ -87,6 +88,7 @@ pub struct GaitPose {
     pub body_height_m: f32,
     /// Body roll and pitch about its forward and sideways axes.
     pub roll_rad: f32,
+    /// Body pitch about its sideways axis.
     pub pitch_rad: f32,
     /// The legs in the kind's order: the first `leg_count` are its legs (a fixed array, so a
     /// pose is copied, never allocated).
@@ -109,10 +111,12 @@ impl GaitPose {
         pose
     }
 
+    /// The creature's legs, in its kind's order.
     pub fn legs(&self) -> &[LegPose] {
         &self.legs[..usize::from(self.leg_count)]
     }
 
+    /// The creature's legs, to change.
     pub fn legs_mut(&mut self) -> &mut [LegPose] {
         &mut self.legs[..usize::from(self.leg_count)]
     }
@@ -201,6 +205,7 @@ pub struct GaitRow {
 #[derive(Asset, TypePath, Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct GaitTable {
+    /// The creature kind it was recorded from.
     pub creature: String,
     /// 1 to 1000 Hz.
     pub sample_hz: f32,
@@ -211,6 +216,7 @@ pub struct GaitTable {
     /// The rigid model's effective limits, which the point mass of the lower levels matches:
     /// 0.01 to 1000 m/s^2 and 0.01 to 50 m/s.
     pub acceleration_limit_m_per_s2: f32,
+    /// The rigid model's top speed (see `acceleration_limit_m_per_s2`).
     pub top_speed_m_per_s: f32,
     /// In increasing order of speed.
     pub rows: Vec<GaitRow>,

@@ -31,9 +31,11 @@ pub struct RecordSettings {
     /// The strides are steady when their periods differ by at most this share of their mean,
     /// and their mean speeds by at most `steady_speed_m_per_s`.
     pub steady_period_share: f32,
+    /// Steady strides' mean speeds differ by at most this (see `steady_period_share`).
     pub steady_speed_m_per_s: f32,
     /// Running time after `settle_s` within which the hops must become steady.
     pub steady_within_s: f32,
+    /// Samples per second of the recorded pose.
     pub sample_hz: f32,
 }
 

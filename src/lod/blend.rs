@@ -28,8 +28,11 @@ const CHANNELS: usize = 6 + 3 * MAX_LEGS;
 /// What is drawn of a creature: its body in the world and its legs.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Drawn {
+    /// The body's centre in the world.
     pub body: Vec3,
+    /// The body's orientation in the world.
     pub rotation: Quat,
+    /// The body's height and tilt and each leg's length and angles.
     pub pose: GaitPose,
 }
 
@@ -153,8 +156,11 @@ pub struct DrawnBefore(pub Option<(Drawn, Drawn)>);
 /// A switch being measured over its first `PROBE_TICKS` ticks.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct SwitchProbe {
+    /// The level left.
     pub from: Lod,
+    /// The level entered.
     pub to: Lod,
+    /// Whether a collision forced the switch outside the flight window.
     pub forced: bool,
     /// Drawn (and by the models alone) two ticks and one tick before the switch.
     before: [Drawn; 2],
@@ -236,6 +242,7 @@ pub type SwitchKind = (Lod, Lod, bool);
 /// Every switch's pop over the run, by kind of switch.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct PopTally {
+    /// Each switch's kind, its pop as drawn and its pop by the models alone.
     pub pops: Vec<(SwitchKind, Pop, Pop)>,
     /// The latest switches (for the game's debug display), newest last.
     pub recent: Vec<(SwitchKind, Pop)>,
@@ -247,7 +254,9 @@ const RECENT_POPS: usize = 6;
 /// The largest and the 95th percentile of one measure.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Spread {
+    /// The largest.
     pub max: f32,
+    /// The 95th percentile.
     pub p95: f32,
 }
 
@@ -270,13 +279,19 @@ impl Spread {
 /// The pops of one kind of switch, as the summary prints them.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PopSummary {
+    /// The level left, by name.
     pub from: &'static str,
+    /// The level entered, by name.
     pub to: &'static str,
+    /// Whether collisions forced these switches outside the flight window.
     pub forced: bool,
+    /// How many switches of this kind.
     pub count: usize,
     /// As drawn, blended.
     pub metres: Spread,
+    /// As drawn: the largest turn of the body or a leg, degrees.
     pub degrees: Spread,
+    /// As drawn: the jump in the body's horizontal velocity.
     pub velocity_m_per_s: Spread,
     /// As the models alone give it, unblended.
     pub model_metres: Spread,

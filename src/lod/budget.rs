@@ -34,6 +34,7 @@ use crate::{SimStage, SimStart};
 /// One creature as the knapsack sees it.
 #[derive(Clone, Debug)]
 pub struct Candidate<'a> {
+    /// The creature's serial: ties go to the lower.
     pub serial: u32,
     /// The level it is simulated at now.
     pub current: Lod,
@@ -43,6 +44,7 @@ pub struct Candidate<'a> {
     pub floor: Lod,
     /// The levels its kind has, cheapest first.
     pub levels: &'a [Lod],
+    /// What each of its levels costs, us per 1/30 s.
     pub costs: LevelCosts,
     /// Benefit of each level, indexed by `Lod as usize`.
     pub benefit: [f32; 3],
@@ -77,6 +79,7 @@ impl Candidate<'_> {
 pub struct Allocation {
     /// One per candidate, in the candidates' order.
     pub levels: Vec<Lod>,
+    /// The frame's predicted simulation time at these levels, us per 1/30 s.
     pub predicted_us: f32,
     /// Even the cheapest allowed levels cost more than the budget.
     pub exceeded: bool,
@@ -184,26 +187,34 @@ pub struct BudgetTally {
     /// resource is a new entity, which moves the rigid bodies' entity ids and so rapier's
     /// rounding.)
     pub measured_us: Option<f32>,
+    /// Decisions taken under the budget policy.
     pub decisions: u64,
     /// Decisions whose predicted frame did not fit the budget even at the cheapest levels
     /// allowed.
     pub over_budget: u64,
+    /// The predicted frames' sum, us (for the mean).
     pub predicted_sum_us: f64,
+    /// The slowest predicted frame, us.
     pub predicted_max_us: f32,
 }
 
 /// The budget policy's run, in the summary.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BudgetSummary {
+    /// The frame budget, ms of simulation per 1/30 s.
     pub frame_budget_ms: f32,
+    /// The predicted frame on average, ms.
     pub predicted_ms_mean: f64,
+    /// The slowest predicted frame, ms.
     pub predicted_ms_max: f32,
+    /// Decisions taken under the budget policy.
     pub decisions: u64,
     /// Decisions where even the cheapest levels allowed were predicted over the budget.
     pub decisions_over_budget: u64,
     /// Whether the adaptive mode corrected the cost model (the run is then not reproducible),
     /// and its last correction (measured over predicted; 1 when off).
     pub adaptive: bool,
+    /// The adaptive mode's last correction, measured over predicted (1 when off).
     pub correction: f32,
 }
 
@@ -228,6 +239,7 @@ impl BudgetTally {
         self.model_us * self.correction
     }
 
+    /// The run so far under `rules`, as the summary reports it.
     pub fn summary(&self, rules: &BudgetRules) -> BudgetSummary {
         BudgetSummary {
             frame_budget_ms: rules.frame_budget_ms,

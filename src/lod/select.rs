@@ -32,6 +32,7 @@ use crate::{SimClock, SimStage, SimStart};
 /// The level the rules want for a creature, and when it last switched.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct LevelChoice {
+    /// The level the policy wants now; the switch waits for the flight window.
     pub wanted: Lod,
     /// Simulated time of the last switch (for `min_dwell_s`).
     pub last_switch_s: f32,
@@ -43,6 +44,7 @@ pub struct LevelChoice {
 /// (figure 9's set-up); a window's camera sets it itself (see [`CameraFromView`]).
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimCamera {
+    /// The camera's position on the ground plane.
     pub position: Vec2,
     /// Unit view direction.
     pub facing: Vec2,

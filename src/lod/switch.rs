@@ -21,29 +21,38 @@ use crate::{SimClock, SimStage, SimStart};
 /// A creature changed level.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
 pub struct LevelSwitched {
+    /// The creature's entity.
     pub creature: Entity,
+    /// The creature's serial.
     pub serial: u32,
+    /// The level it left.
     pub from: Lod,
+    /// The level it entered.
     pub to: Lod,
     /// How far through its flight phase it was (0 lift-off, 1 touchdown); `None` when a
     /// collision forced the switch.
     pub flight_progress: Option<f32>,
+    /// Simulated seconds at the switch.
     pub at_s: f32,
 }
 
 /// Switches and creatures per level over the run.
 #[derive(Resource, Clone, Debug, Default)]
 pub struct SwitchTally {
+    /// Switches by where they came from and went to.
     pub switches: SwitchCounts,
     /// Sums and peaks of the creatures at each level, sampled at each decision.
     pub level_sums: Counts<Lod, u64>,
+    /// The most creatures at each level at any sampled decision.
     pub level_peaks: Counts<Lod, u64>,
+    /// How many decisions were sampled.
     pub samples: u64,
     /// The cost model's prediction of each sampled frame from the levels simulated in it (the
     /// fixed cost and each creature's level; not the policy's own choice): its sum and the
     /// slowest, in microseconds. Every policy's, so they compare on what they guarantee.
     /// (Summed in f64, where the f32 costs add exactly: the same whatever the creatures' order.)
     pub predicted_frame_sum_us: f64,
+    /// The slowest predicted frame, us (see `predicted_frame_sum_us`).
     pub predicted_frame_max_us: f64,
 }
 

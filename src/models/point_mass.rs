@@ -25,6 +25,7 @@ pub struct TurnLimit {
 }
 
 impl TurnLimit {
+    /// The turn a creature of `kind` may make in a tick of `dt` seconds.
     pub fn new(kind: &KindParams, dt: f32) -> Self {
         let max_turn = kind.turn_rate_rad_per_s * dt;
         Self {

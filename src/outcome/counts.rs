@@ -94,14 +94,17 @@ impl<K: Key, T: Serialize> Serialize for Counts<K, T> {
 pub struct SwitchCounts(pub Counts<Lod, Counts<Lod, u64>>);
 
 impl SwitchCounts {
+    /// Every switch.
     pub fn total(&self) -> u64 {
         self.0.values.iter().flat_map(|to| to.values).sum()
     }
 
+    /// Switches from `from` to `to`.
     pub fn between(&self, from: Lod, to: Lod) -> u64 {
         self.0[from][to]
     }
 
+    /// Counts one switch from `from` to `to`.
     pub fn count(&mut self, from: Lod, to: Lod) {
         self.0[from][to] += 1;
     }

@@ -41,8 +41,10 @@ pub enum Obstacle {
 }
 
 impl Obstacle {
+    /// Every obstacle, in the summary's order.
     pub const ALL: [Obstacle; 3] = [Obstacle::Puck, Obstacle::Wall, Obstacle::Creature];
 
+    /// The name in summaries.
     pub fn name(self) -> &'static str {
         match self {
             Obstacle::Puck => "puck",
@@ -114,11 +116,13 @@ impl CollisionTotals {
 pub struct Tally {
     /// The collision records of creatures already removed.
     pub removed: CollisionTotals,
+    /// Falls of creatures already removed.
     pub falls: u64,
     /// Falls by the level the creature was at.
     pub falls_by_level: Counts<Lod, u64>,
     /// Falls within one step of a switch into the rigid level.
     pub falls_after_switch: u64,
+    /// Creatures respawned after a fall.
     pub respawns: u64,
 }
 
@@ -380,14 +384,18 @@ pub(crate) fn advance_clock(mut clock: ResMut<SimClock>) {
 /// simulated (the court's fixed cost and each creature's level).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct PredictedFrame {
+    /// The predicted frame on average.
     pub mean_ms: f64,
+    /// The slowest predicted frame: the frame rate a policy can promise.
     pub slowest_ms: f64,
 }
 
 /// What a run did, as the command line prints it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
+    /// The seed the run started from.
     pub seed: u64,
+    /// Creatures in the world (constant: a fallen one is respawned).
     pub creatures: u64,
     /// Collisions by obstacle (`puck`, `wall`, `creature`); a contact between two creatures
     /// counts once for each.
@@ -397,11 +405,13 @@ pub struct Summary {
     /// Creatures that collided with each obstacle at least once (figure 10's measure by
     /// obstacle: a creature that hit both counts under each).
     pub creatures_collided_with: Counts<Obstacle, u64>,
+    /// Creatures that fell (knocked down, or at the rigid level, lost their balance).
     pub falls: u64,
     /// Falls by the level the creature was at when it fell.
     pub falls_by_level: Counts<Lod, u64>,
     /// Falls within one step (touchdown to touchdown) of a switch into the rigid level.
     pub falls_after_switch: u64,
+    /// Creatures respawned after a fall.
     pub respawns: u64,
     /// Creatures at each level at the end.
     pub levels: Counts<Lod, u64>,
@@ -409,6 +419,7 @@ pub struct Summary {
     pub switches: SwitchCounts,
     /// Creatures at each level, averaged over the run's steering decisions, and the peak.
     pub levels_mean: Counts<Lod, f64>,
+    /// The most creatures at each level at any decision.
     pub levels_peak: Counts<Lod, u64>,
     /// The cost model's prediction of a frame from the levels simulated in it, whatever the
     /// policy: on average and the slowest.
@@ -419,9 +430,11 @@ pub struct Summary {
     /// Under the budget policy: the budget, the predicted frame and the decisions over it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub budget: Option<BudgetSummary>,
+    /// Simulated seconds.
     pub sim_seconds: f64,
     /// Wall-clock seconds; the only field that differs between identical runs.
     pub wall_seconds: f64,
+    /// Simulated seconds per wall-clock second.
     pub realtime_factor: f64,
 }
 

@@ -10,9 +10,13 @@ use crate::{SimClock, SimStage, SimStart};
 /// What a creature knows of a neighbour: a snapshot taken when the index was built.
 #[derive(Clone, Copy, Debug)]
 pub struct Neighbour {
+    /// Metres, on the ground plane.
     pub position: Vec2,
+    /// Metres per second, on the ground plane.
     pub velocity: Vec2,
+    /// Its footprint's radius, metres.
     pub radius: f32,
+    /// Its mass, kg.
     pub mass: f32,
     /// The neighbour's [`Creature::serial`], so a creature can skip itself.
     pub serial: u32,
@@ -116,10 +120,12 @@ impl NeighbourGrid {
         }
     }
 
+    /// Creatures in the index.
     pub fn len(&self) -> usize {
         self.entries.len()
     }
 
+    /// Whether the index holds no creature.
     pub fn is_empty(&self) -> bool {
         self.entries.is_empty()
     }

@@ -203,12 +203,37 @@ fn a_leg_shorter_than_it_is_thick_is_refused() {
 #[test]
 fn a_creature_that_cannot_exist_is_refused_naming_the_fields_that_disagree() {
     for (from, to, field, words) in [
-        ("hip_height_m: 0.8", "hip_height_m: 1.5", "body.hip_height_m", "where the leg cannot stand"),
-        ("rest_length_m: 0.75", "rest_length_m: 0.9", "legs[0].rest_length_m", "upper_length_m + lower_length_m"),
-        ("hip_m: (0.0, 0.0, 0.0)", "hip_m: (0.0, 0.0, 0.5)", "legs[0].hip_m", "outside body.radius_m"),
-        ("hip_m: (0.0, 0.0, 0.0)", "hip_m: (0.0, 0.0, 0.25)", "rigid.body_half_extents_m", "outside the body box"),
+        (
+            "hip_height_m: 0.8",
+            "hip_height_m: 1.5",
+            "body.hip_height_m",
+            "where the leg cannot stand",
+        ),
+        (
+            "rest_length_m: 0.75",
+            "rest_length_m: 0.9",
+            "legs[0].rest_length_m",
+            "upper_length_m + lower_length_m",
+        ),
+        (
+            "hip_m: (0.0, 0.0, 0.0)",
+            "hip_m: (0.0, 0.0, 0.5)",
+            "legs[0].hip_m",
+            "outside body.radius_m",
+        ),
+        (
+            "hip_m: (0.0, 0.0, 0.0)",
+            "hip_m: (0.0, 0.0, 0.25)",
+            "rigid.body_half_extents_m",
+            "outside the body box",
+        ),
         ("stance: Together", "stance: Alternating", "stance", "at least 2"),
-        ("body_min_height_m: 0.4", "body_min_height_m: 0.85", "rigid.fall.body_min_height_m", "below body.hip_height_m"),
+        (
+            "body_min_height_m: 0.4",
+            "body_min_height_m: 0.85",
+            "rigid.fall.body_min_height_m",
+            "below body.hip_height_m",
+        ),
     ] {
         let file = "creatures/hopper.ron";
         let err = load_error("impossible_creature", file, &edited(file, from, to));

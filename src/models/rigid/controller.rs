@@ -65,6 +65,7 @@ enum Role {
 /// The controller's state for one creature.
 #[derive(Component, Clone, Debug)]
 pub struct Raibert {
+    /// Flight, compression or thrust.
     pub phase: StancePhase,
     /// The leg that touched down last: in stance now, or the last one that was.
     pub stance_leg: usize,
@@ -72,7 +73,9 @@ pub struct Raibert {
     pub thrust_m: f32,
     /// Estimated stance duration, for the neutral point.
     pub stance_s: f32,
+    /// Simulated seconds of the last touchdown.
     pub last_touchdown_s: f32,
+    /// Simulated seconds of the last lift-off.
     pub last_liftoff_s: f32,
     /// Touchdown to touchdown, last measured.
     pub hop_period_s: f32,
@@ -85,6 +88,7 @@ pub struct Raibert {
     /// When the creature entered the rigid level, and each leg's length then: the idle legs'
     /// servo starts from there (see `Raibert::spring_target`).
     pub entry_s: f32,
+    /// Each leg's length when the creature entered the rigid level (see `entry_s`).
     pub entry_lengths_m: [f32; MAX_LEGS],
 }
 

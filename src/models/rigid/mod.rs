@@ -28,6 +28,7 @@ use crate::{SimClock, SimStage};
 /// The rapier bodies of one leg.
 #[derive(Clone, Copy, Debug)]
 pub struct LegBodies {
+    /// The upper leg, on the three-axis hip.
     pub upper: Entity,
     /// The telescoping lower leg, its ball foot at its end.
     pub lower: Entity,
@@ -36,7 +37,9 @@ pub struct LegBodies {
 /// The rapier bodies of a rigid creature: its body, then its legs in the kind's order.
 #[derive(Component, Clone, Debug)]
 pub struct RigidBodies {
+    /// The body box.
     pub body: Entity,
+    /// Each leg's bodies, in the kind's order.
     pub legs: Vec<LegBodies>,
 }
 
@@ -50,6 +53,7 @@ impl RigidBodies {
 /// A rapier body that belongs to a creature.
 #[derive(Component, Clone, Copy, Debug)]
 pub struct RigidPart {
+    /// The creature it belongs to.
     pub creature: Entity,
 }
 
@@ -102,6 +106,7 @@ pub struct RigidStart {
     pub hip_rotations: [Vec3; MAX_LEGS],
     /// Each leg's length past its rest length (its prismatic joint's coordinate).
     pub leg_extensions_m: [f32; MAX_LEGS],
+    /// The body's velocity at entry, m/s.
     pub velocity: Vec3,
 }
 
