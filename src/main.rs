@@ -63,6 +63,8 @@ struct RecordGaitArgs {
 
 impl RecordGaitArgs {
     fn run(&self) -> Result<(), String> {
+        self.scenario
+            .refuse_level_flags("record-gait", "it runs the kind's rigid model alone, at steady speeds")?;
         let def: CreatureDef = load_file(&self.creature).map_err(|e| e.to_string())?;
         let mut config = self.scenario.load_measuring(MeasuredAnew {
             gait_table_of: Some(&def.name),
@@ -225,6 +227,10 @@ struct ExperimentRun {
 
 impl ExperimentRun {
     fn run(&self, name: &str) -> Result<(), String> {
+        self.scenario.refuse_level_flags(
+            "experiment",
+            "each experiment sets its own level policy, rules and radii from its file (assets/experiments/<name>.ron; --experiment FILE reads another)",
+        )?;
         let config = self.scenario.load()?;
         let options = experiments::Options {
             out: self.out.clone(),
@@ -322,6 +328,22 @@ fn scenario_file(assets: &Path, scenario: Option<&Path>) -> PathBuf {
 const DEFAULT_SCENARIO: &str = "scenarios/default.ron";
 
 impl ScenarioArgs {
+    /// Refuses the level flags (policy, rules, radii, budget) for a command that never reads
+    /// them, saying `why`, rather than let them be ignored without a word.
+    fn refuse_level_flags(&self, command: &str, why: &str) -> Result<(), String> {
+        let given = [
+            ("--policy", self.policy.is_some()),
+            ("--puck-radius", self.puck_radius.is_some()),
+            ("--camera-radius", self.camera_radius.is_some()),
+            ("--frame-budget", self.frame_budget.is_some()),
+            ("--rules", self.rules.is_some()),
+        ];
+        match given.iter().find(|(_, given)| *given) {
+            Some((flag, _)) => Err(format!("{flag} does not apply to `simlod {command}`: {why}")),
+            None => Ok(()),
+        }
+    }
+
     fn scenario_file(&self) -> PathBuf {
         scenario_file(&self.assets, self.scenario.as_deref())
     }

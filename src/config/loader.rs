@@ -21,7 +21,7 @@ pub fn parse_ron<T: DeserializeOwned + Validate>(bytes: &[u8], file: &Path) -> R
     if text.trim().is_empty() {
         return Err(ConfigError::one(file, "", "the file is empty"));
     }
-    let value: T = parse_text(text).map_err(|(path, e)| parse_error(file, &path, e))?;
+    let value: T = parse_text(text).map_err(|(path, e)| parse_error(file, text, &path, e))?;
     let mut v = Validator::default();
     value.validate(&mut v);
     v.finish(file)?;
@@ -57,8 +57,11 @@ fn field_path(path: &str, named: Option<&str>) -> String {
     parts.join(".")
 }
 
-fn parse_error(file: &Path, path: &str, e: ron::error::SpannedError) -> ConfigError {
+fn parse_error(file: &Path, text: &str, path: &str, e: ron::error::SpannedError) -> ConfigError {
     use ron::Error;
+    if let Some((field, message)) = wrong_type(text, path, &e) {
+        return ConfigError::one(file, field, message);
+    }
     let named = match &e.code {
         Error::MissingStructField { field, .. } | Error::DuplicateStructField { field, .. } => Some(*field),
         Error::NoSuchStructField { found, .. } => Some(found.as_str()),
@@ -77,6 +80,67 @@ fn parse_error(file: &Path, path: &str, e: ron::error::SpannedError) -> ConfigEr
         code => format!("line {}, column {}: {code}", e.position.line, e.position.col),
     };
     ConfigError::one(file, field, message)
+}
+
+/// A value of the wrong type, named by its field with what was expected and what was found.
+/// The parser's own words name only the token it wanted next: after the `10` of `count: 10.5`
+/// it wants a comma.
+fn wrong_type(text: &str, path: &str, e: &ron::error::SpannedError) -> Option<(String, String)> {
+    use ron::Error;
+    let at = byte_offset(text, e.position.line, e.position.col)?;
+    let line = e.position.line;
+    let expected = match &e.code {
+        Error::ExpectedInteger => "a whole number",
+        Error::ExpectedFloat => "a number",
+        Error::ExpectedBoolean => "true or false",
+        Error::ExpectedString => "text in double quotes",
+        Error::ExpectedComma | Error::ExpectedStructLikeEnd | Error::ExpectedArrayEnd | Error::TrailingCharacters => {
+            // A fraction where a whole number was read: the parser stopped at its `.`.
+            let before = &text[..at];
+            let digits = before.trim_end_matches(|c: char| c.is_ascii_digit());
+            if !text[at..].starts_with('.') || digits.len() == before.len() {
+                return None;
+            }
+            let number_start = digits.trim_end_matches(['-', '+']).len();
+            let key = digits[..number_start].trim_end().strip_suffix(':')?.trim_end();
+            let key_start = key
+                .trim_end_matches(|c: char| c.is_ascii_alphanumeric() || c == '_')
+                .len();
+            let key = &key[key_start..];
+            let found = value_at(text, number_start);
+            let field = field_path(path, (!key.is_empty()).then_some(key));
+            return Some((field, format!("expected a whole number, found {found} (line {line})")));
+        }
+        _ => return None,
+    };
+    let found = value_at(text, at);
+    Some((
+        field_path(path, None),
+        format!("expected {expected}, found {found} (line {line})"),
+    ))
+}
+
+/// The byte where a parser position (1-based line, 1-based column in characters) is.
+fn byte_offset(text: &str, line: usize, col: usize) -> Option<usize> {
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line.checked_sub(1)?)
+        .map(str::len)
+        .sum();
+    let line_text = text.get(start..)?.split('\n').next()?;
+    let within = line_text
+        .char_indices()
+        .nth(col.checked_sub(1)?)
+        .map_or(line_text.len(), |(i, _)| i);
+    Some(start + within)
+}
+
+/// The value written at `at`: up to the next delimiter or the end of its line.
+fn value_at(text: &str, at: usize) -> &str {
+    let rest = &text[at..];
+    let end = rest.find([',', ')', ']', '}', '\n']).unwrap_or(rest.len());
+    let found = rest[..end].trim();
+    if found.is_empty() { "nothing" } else { found }
 }
 
 /// Bevy asset loader for any validated RON asset type: the game's hot-reload path.

@@ -11,7 +11,7 @@ use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::plot::{self, Mark, Panel, Series};
-use super::{ExperimentRecord, Options, command, load_settings, mean_and_variance, run_parallel, trials};
+use super::{ExperimentRecord, Options, Shard, command, load_settings, mean_and_variance, run_parallel, trials};
 use crate::config::{LevelRules, SimConfig, Validate, Validator, load_file};
 use crate::headless;
 use crate::lod::{LevelPolicy, Lod};
@@ -49,6 +49,98 @@ impl Validate for Fig10Settings {
 }
 
 const HEADER: &str = "puck_radius_m,trial,seed,seconds,rules,collided,collided_all_rigid,difference,falls,falls_all_rigid,mean_rigid,wall_s,wall_s_all_rigid";
+
+/// What a part of figure 10's trials is, written beside its CSV as `fig10.part.json`: a merge
+/// or a resume takes only parts made by the same plan and the same simlod, whole and unedited.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Part {
+    /// Always `fig10`.
+    pub experiment: String,
+    /// The simlod version that ran the trials.
+    pub version: String,
+    /// A digest of everything a trial's outcome depends on: the scenario and every file it
+    /// names, the rules the trials run under, the radii, the trial length and the seeds.
+    pub plan: String,
+    /// The trials of the whole run, over all parts.
+    pub trials: u32,
+    /// Which part of them, `K/N`.
+    pub shard: String,
+    /// Rows in the CSV.
+    pub rows: usize,
+    /// A digest of the CSV's bytes.
+    pub checksum: String,
+}
+
+const PART_FILE: &str = "fig10.part.json";
+/// Beside the journal of an unfinished run: the plan its rows were made by.
+const JOURNAL_PLAN_FILE: &str = "fig10.partial.plan";
+
+/// FNV-1a, written out so that a digest on disk means the same to every build.
+fn digest(bytes: &[u8]) -> String {
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325_u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!("{hash:016x}")
+}
+
+/// The plan's digest: the config as the trials run it (their rules, any seed and policy) and
+/// the settings but the trial count, which decides only how many trials there are.
+fn plan_digest(config: &SimConfig, rules: &LevelRules, s: &Fig10Settings) -> String {
+    let mut c = config.clone();
+    c.rules = rules.clone();
+    c.scenario.seed = 0;
+    c.scenario.level_policy = LevelPolicy::AllRigid;
+    let s = Fig10Settings { trials: 0, ..s.clone() };
+    digest(format!("{c:?}\n{s:?}").as_bytes())
+}
+
+/// Reads `dir`'s part record and checks its CSV against it.
+fn read_part(dir: &Path) -> Result<(Part, Vec<Row>), String> {
+    let (csv_path, part_path) = (dir.join("fig10.csv"), dir.join(PART_FILE));
+    let csv = std::fs::read(&csv_path).map_err(|e| {
+        format!(
+            "{}: {e} (is {} a finished fig10 run or shard?)",
+            csv_path.display(),
+            dir.display()
+        )
+    })?;
+    let part: Part = std::fs::read_to_string(&part_path)
+        .map_err(|e| {
+            format!(
+                "{}: {e}: without it nothing says what made {}",
+                part_path.display(),
+                csv_path.display()
+            )
+        })
+        .and_then(|json| {
+            serde_json::from_str(&json).map_err(|e| format!("{}: not a fig10 part record: {e}", part_path.display()))
+        })?;
+    if part.experiment != "fig10" {
+        return Err(format!(
+            "{}: a part of {}, not of fig10",
+            part_path.display(),
+            part.experiment
+        ));
+    }
+    if digest(&csv) != part.checksum {
+        return Err(format!(
+            "{}: changed since it was written (its checksum is {}, its part record says {}): cut short, edited or copied from another run",
+            csv_path.display(),
+            digest(&csv),
+            part.checksum
+        ));
+    }
+    let rows = read_rows(&csv_path)?.unwrap_or_default();
+    if rows.len() != part.rows {
+        return Err(format!(
+            "{}: {} rows, and its part record says {}",
+            csv_path.display(),
+            rows.len(),
+            part.rows
+        ));
+    }
+    Ok((part, rows))
+}
 
 /// One trial at one radius, beside the identical trial all rigid.
 #[derive(Clone, Debug, PartialEq)]
@@ -129,6 +221,11 @@ pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, String> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Ok(None);
     };
+    rows_of(&text, path).map(Some)
+}
+
+/// The rows of a fig10 table's `text`, read from `path`.
+fn rows_of(text: &str, path: &Path) -> Result<Vec<Row>, String> {
     let mut lines = text.lines();
     if lines.next() != Some(HEADER) {
         return Err(format!(
@@ -140,8 +237,7 @@ pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, String> {
         .enumerate()
         .filter(|(_, l)| !l.is_empty())
         .map(|(i, l)| Row::parse(l).ok_or_else(|| format!("{}: line {}: not a fig10 row: {l}", path.display(), i + 2)))
-        .collect::<Result<Vec<_>, _>>()
-        .map(Some)
+        .collect()
 }
 
 /// One trial: the all-rigid run, then the influence policy at every radius, same seed.
@@ -188,17 +284,38 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     let out = &options.out;
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let (done_path, partial_path) = (out.join("fig10.csv"), out.join("fig10.partial.csv"));
-    // What an earlier run of the same plan finished: whole trials only.
-    let mut earlier = read_rows(&done_path)?.unwrap_or_default();
-    earlier.extend(read_rows(&partial_path)?.unwrap_or_default());
+    let plan = plan_digest(config, &rules, &s);
+    // What an earlier run of the same plan finished, whole trials only; a part made by another
+    // plan or another simlod is refused, never mixed in.
+    let mut earlier = Vec::new();
+    if done_path.exists() {
+        let (part, rows) = read_part(out)?;
+        same_plan(&part.plan, &part.version, &plan, &done_path)?;
+        earlier = rows;
+    }
+    let journal_plan = out.join(JOURNAL_PLAN_FILE);
+    if partial_path.exists() {
+        let made_by = std::fs::read_to_string(&journal_plan).map_err(|e| {
+            format!(
+                "{}: {e}: without it nothing says what made {}",
+                journal_plan.display(),
+                partial_path.display()
+            )
+        })?;
+        let (version, made_by) = made_by.trim().split_once(' ').unwrap_or(("", made_by.trim()));
+        same_plan(made_by, version, &plan, &partial_path)?;
+        earlier.extend(read_journal(&partial_path)?);
+    }
+    std::fs::write(&journal_plan, format!("{} {plan}\n", env!("CARGO_PKG_VERSION")))
+        .map_err(|e| format!("cannot write {}: {e}", journal_plan.display()))?;
     let mine: Vec<u32> = (0..s.trials).filter(|&t| options.shard.owns(t)).collect();
-    let plan = &s;
+    let settings = &s;
     let wanted: BTreeSet<_> = mine
         .iter()
         .flat_map(|&t| {
-            plan.radii_m.iter().map(move |r| {
-                let seed = plan.first_seed + u64::from(t);
-                (r.to_bits(), seed, t, plan.seconds.to_bits(), plan.rules.clone())
+            settings.radii_m.iter().map(move |r| {
+                let seed = settings.first_seed + u64::from(t);
+                (r.to_bits(), seed, t, settings.seconds.to_bits(), settings.rules.clone())
             })
         })
         .collect();
@@ -249,36 +366,111 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         return Err(e);
     }
     let rows: Vec<Row> = by_trial.into_values().flatten().collect();
+    let part = PartOf {
+        plan,
+        trials: s.trials,
+        shard: options.shard,
+    };
     let text = finish(
         rows,
         out,
         &command("fig10", options),
         (&options.scenario, &options.assets),
         options.quick,
+        &part,
     )?;
     let _ = std::fs::remove_file(&partial_path);
+    let _ = std::fs::remove_file(&journal_plan);
     Ok(text)
+}
+
+/// Which part of which plan a finished run is.
+struct PartOf {
+    plan: String,
+    trials: u32,
+    shard: Shard,
+}
+
+/// Refuses `file`, made by plan `made_by` with simlod `version`, for a run of plan `plan`.
+fn same_plan(made_by: &str, version: &str, plan: &str, file: &Path) -> Result<(), String> {
+    let this = env!("CARGO_PKG_VERSION");
+    if version != this {
+        return Err(format!(
+            "{}: made by simlod {version}, and this is {this}: move it away or write to another --out",
+            file.display()
+        ));
+    }
+    if made_by != plan {
+        return Err(format!(
+            "{}: made with other settings (plan {made_by}; this run's is {plan}: the scenario, its files, the rules, the radii, the trial length or the seeds differ): move it away or write to another --out",
+            file.display()
+        ));
+    }
+    Ok(())
+}
+
+/// The rows of an unfinished run's journal. Its last line, cut short by the interruption
+/// (no line end), is a trial that did not finish: dropped, and the trial runs again.
+fn read_journal(path: &Path) -> Result<Vec<Row>, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let whole = text.rfind('\n').map_or("", |end| &text[..=end]);
+    if whole.len() < text.len() {
+        eprintln!(
+            "fig10: {}: its last line was cut short; that trial runs again",
+            path.display()
+        );
+    }
+    rows_of(whole, path)
 }
 
 /// `simlod experiment merge DIR... --out OUT`: the shards' rows as one run's.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
     let mut rows = Vec::new();
     let mut seen = BTreeSet::new();
-    let mut origin: Option<(PathBuf, PathBuf)> = None;
+    let mut first: Option<(&Path, Part)> = None;
+    let mut shards = BTreeSet::new();
     for dir in dirs {
-        let path = dir.join("fig10.csv");
-        let part = read_rows(&path)?.ok_or_else(|| {
-            format!(
-                "{}: no such file (is {} a finished fig10 shard?)",
-                path.display(),
-                dir.display()
-            )
-        })?;
-        for row in part {
+        let (part, part_rows) = read_part(dir)?;
+        let shard: Shard = part
+            .shard
+            .parse()
+            .map_err(|e| format!("{}: field `shard`: {e}", dir.join(PART_FILE).display()))?;
+        if let Some((first_dir, f)) = &first {
+            for (what, this, that) in [
+                ("simlod version", &part.version, &f.version),
+                (
+                    "plan (the scenario, its files, the rules, the radii, the trial length or the seeds)",
+                    &part.plan,
+                    &f.plan,
+                ),
+                ("trial count", &part.trials.to_string(), &f.trials.to_string()),
+                (
+                    "number of shards",
+                    &shard.n.to_string(),
+                    &f.shard.split('/').nth(1).unwrap_or("").to_owned(),
+                ),
+            ] {
+                if this != that {
+                    return Err(format!(
+                        "{}: its {what} is {this}, and {}'s is {that}: they are not parts of one run",
+                        dir.display(),
+                        first_dir.display()
+                    ));
+                }
+            }
+        }
+        if !shards.insert(shard.k) {
+            return Err(format!(
+                "{}: shard {} is given twice: the parts overlap",
+                dir.display(),
+                part.shard
+            ));
+        }
+        for row in part_rows {
             if !seen.insert(row.key()) {
                 return Err(format!(
                     "{}: trial {} (seed {}) at {} m is also in another part: the parts overlap",
-                    path.display(),
+                    dir.join("fig10.csv").display(),
                     row.trial,
                     row.seed,
                     row.puck_radius_m
@@ -286,25 +478,36 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
             }
             rows.push(row);
         }
-        if origin.is_none()
-            && let Ok(json) = std::fs::read_to_string(dir.join("fig10.json"))
-            && let Ok(record) = serde_json::from_str::<ExperimentRecord>(&json)
-        {
-            let text = |k: &str| record.summary[k].as_str().map(PathBuf::from);
-            origin = text("scenario").zip(text("assets"));
-        }
+        first.get_or_insert((dir.as_path(), part));
     }
-    let (scenario, assets) = origin.unwrap_or_else(|| ("assets/scenarios/default.ron".into(), "assets".into()));
+    let Some((first_dir, first)) = first else {
+        return Err("name the folders of the parts to merge".to_owned());
+    };
+    let n: u32 = first.shard.split('/').nth(1).and_then(|n| n.parse().ok()).unwrap_or(1);
+    if let Some(k) = (1..=n).find(|k| !shards.contains(k)) {
+        return Err(format!(
+            "shard {k}/{n} is missing: merged, the parts would not be one run's {} trials",
+            first.trials
+        ));
+    }
+    let record = std::fs::read_to_string(first_dir.join("fig10.json"))
+        .ok()
+        .and_then(|json| serde_json::from_str::<ExperimentRecord>(&json).ok());
+    let text = |r: &ExperimentRecord, k: &str| r.summary[k].as_str().map(PathBuf::from);
+    let (scenario, assets) = record
+        .as_ref()
+        .and_then(|r| text(r, "scenario").zip(text(r, "assets")))
+        .unwrap_or_else(|| ("assets/scenarios/default.ron".into(), "assets".into()));
     // Shards of a smoke test merge into a smoke test.
-    let smoke_test = dirs.iter().any(|dir| {
-        std::fs::read_to_string(dir.join("fig10.json"))
-            .ok()
-            .and_then(|json| serde_json::from_str::<ExperimentRecord>(&json).ok())
-            .is_some_and(|record| record.smoke_test)
-    });
+    let smoke_test = record.is_some_and(|r| r.smoke_test);
     let dirs: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
     let command = format!("simlod experiment merge {} --out {}", dirs.join(" "), out.display());
-    finish(rows, out, &command, (&scenario, &assets), smoke_test)
+    let part = PartOf {
+        plan: first.plan,
+        trials: first.trials,
+        shard: Shard::WHOLE,
+    };
+    finish(rows, out, &command, (&scenario, &assets), smoke_test, &part)
 }
 
 /// Figures per radius.
@@ -372,6 +575,7 @@ fn finish(
     command: &str,
     (scenario, assets): (&Path, &Path),
     smoke_test: bool,
+    part: &PartOf,
 ) -> Result<String, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     rows.sort_by(|a, b| a.puck_radius_m.total_cmp(&b.puck_radius_m).then(a.trial.cmp(&b.trial)));
@@ -379,6 +583,18 @@ fn finish(
     for row in &rows {
         csv += &(row.to_csv() + "\n");
     }
+    let record = Part {
+        experiment: "fig10".to_owned(),
+        version: env!("CARGO_PKG_VERSION").to_owned(),
+        plan: part.plan.clone(),
+        trials: part.trials,
+        shard: format!("{}/{}", part.shard.k, part.shard.n),
+        rows: rows.len(),
+        checksum: digest(csv.as_bytes()),
+    };
+    let json = serde_json::to_string_pretty(&record).expect("a part record serialises");
+    super::write_out(out, "fig10.csv", &csv)?;
+    super::write_out(out, PART_FILE, &(json + "\n"))?;
     let per_radius = summarise(&rows);
     let difference: Vec<(f64, f64)> = per_radius
         .iter()
@@ -491,5 +707,5 @@ fn finish(
         report,
         smoke_test,
     }
-    .finish(out, &csv)
+    .save(out, &["fig10.csv", PART_FILE, "fig10.png"])
 }

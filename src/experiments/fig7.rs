@@ -82,7 +82,7 @@ fn mixed_frame_seconds(base: &SimConfig, n: u32, percent: u32, warmup: usize, fr
 
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: Fig7Settings = load_settings(file, options)?;
-    check_kind(config, file, "creature", &s.creature)?;
+    check_kind(config, file, "creature", &s.creature, &[Lod::Hybrid, Lod::Rigid])?;
     let base = only_kind(config, &s.creature);
     let n_trials = trials(options, s.trials);
     let mut csv = String::from("rigid_percent,creatures_30fps,rigid_creatures,hybrid_creatures\n");

@@ -15,7 +15,7 @@ use super::{EXPERIMENT_COURT_M, ExperimentRecord, lone_creature, write_out};
 const START_MARGIN_M: f32 = 50.0;
 use crate::config::{ConfigError, SimConfig, Validate, Validator, load_file};
 use crate::creature::{DesiredVelocity, PlanarState};
-use crate::lod::LevelPolicy;
+use crate::lod::{LevelPolicy, Lod};
 
 /// `assets/experiments/step_response.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -37,7 +37,7 @@ pub struct VelocityStep {
 
 impl Validate for StepResponseConfig {
     fn validate(&self, v: &mut Validator) {
-        v.positive("duration_s", self.duration_s);
+        v.within("duration_s", self.duration_s, 1.0 / 30.0, crate::config::MAX_DURATION_S);
         // The run must stay in the experiment's court: a start well inside it.
         let reach = EXPERIMENT_COURT_M / 2.0 - START_MARGIN_M;
         v.within("start_m.0", self.start_m.0, -reach, reach);
@@ -113,13 +113,13 @@ pub fn trace(
 /// ended, and how far apart) into `out`; returns a summary.
 pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result<String, String> {
     let experiment: StepResponseConfig = load_file(experiment_file).map_err(|e: ConfigError| e.to_string())?;
-    if sim_config.kind_index(&experiment.creature).is_none() {
-        return Err(format!(
-            "{}: field `creature`: the scenario has no creature kind {:?}",
-            experiment_file.display(),
-            experiment.creature
-        ));
-    }
+    super::check_kind(
+        sim_config,
+        experiment_file,
+        "creature",
+        &experiment.creature,
+        &[Lod::Hybrid, Lod::Rigid],
+    )?;
     let traces = [
         trace(sim_config, &experiment, "rigid", LevelPolicy::AllRigid),
         trace(sim_config, &experiment, "hybrid", LevelPolicy::AllHybrid),

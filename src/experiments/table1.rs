@@ -85,7 +85,7 @@ type KindCosts = [Option<[f64; 2]>; 3];
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: Table1Settings = load_settings(file, options)?;
     for (i, kind) in s.kinds.iter().enumerate() {
-        check_kind(config, file, &format!("kinds[{i}]"), kind)?;
+        check_kind(config, file, &format!("kinds[{i}]"), kind, &[])?;
     }
     let kinds = KindTable::of(config);
     let n_trials = trials(options, s.trials);

@@ -604,6 +604,43 @@ fn values_of_the_wrong_type_are_named_by_their_whole_path() {
 }
 
 #[test]
+fn a_value_of_the_wrong_type_says_what_was_expected_and_what_was_found() {
+    for (file, from, to, field, said) in [
+        (
+            "scenarios/default.ron",
+            "count: 30",
+            "count: 10.5",
+            "creatures[0].count",
+            "expected a whole number, found 10.5",
+        ),
+        (
+            "scenarios/default.ron",
+            "tick_hz: 240",
+            "tick_hz: 240.5",
+            "tick_hz",
+            "expected a whole number, found 240.5",
+        ),
+        (
+            "creatures/hopper.ron",
+            "mass_kg: 10.0,",
+            "mass_kg: \"heavy\",",
+            "body.mass_kg",
+            "expected a number, found \"heavy\"",
+        ),
+        (
+            "rules/levels.ron",
+            "min_dwell_s: 0.5",
+            "min_dwell_s: yes",
+            "min_dwell_s",
+            "expected a number, found yes",
+        ),
+    ] {
+        let err = load_error("wrong_type_found", file, &edited(file, from, to));
+        assert_names(&err, file, field, said);
+    }
+}
+
+#[test]
 fn more_creatures_than_the_court_can_hold_are_refused_at_once_with_the_numbers() {
     let err = load_error(
         "too_many",

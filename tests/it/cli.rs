@@ -165,6 +165,33 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
         &["run", "--policy", "influence", "--camera-radius", "3"],
         "--camera-radius does not apply",
     );
+    // Experiments and the recorder set their own policy and rules: the flags are refused there.
+    refused(
+        &[
+            "experiment",
+            "fig10",
+            "--quick",
+            "--out",
+            "target/never",
+            "--puck-radius",
+            "3",
+        ],
+        "--puck-radius does not apply to `simlod experiment`",
+    );
+    refused(
+        &["experiment", "table1", "--out", "target/never", "--policy", "all-rigid"],
+        "--policy does not apply to `simlod experiment`",
+    );
+    refused(
+        &[
+            "record-gait",
+            "--creature",
+            "assets/creatures/hopper.ron",
+            "--rules",
+            "rules/levels.ron",
+        ],
+        "--rules does not apply to `simlod record-gait`",
+    );
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["play", "--frame-budget=-1"], "10000 ms");

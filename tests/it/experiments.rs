@@ -326,8 +326,26 @@ fn an_interrupted_fig10_resumes_without_redoing_finished_trials() {
         .filter(|(i, l)| *i == 0 || [",0,", ",2,"].iter().any(|t| l.contains(t)))
         .map(|(_, l)| l.to_owned())
         .collect();
+    // An interrupted run leaves its journal, the plan it was made by, and perhaps a line cut
+    // short by the interruption (trial 1's, here: it runs again).
+    let part: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(options.out.join("fig10.part.json")).unwrap()).unwrap();
+    let cut = whole.iter().find(|r| r[1] == "1").unwrap().join(",");
     std::fs::remove_file(options.out.join("fig10.csv")).unwrap();
-    std::fs::write(options.out.join("fig10.partial.csv"), keep.join("\n") + "\n").unwrap();
+    std::fs::write(
+        options.out.join("fig10.partial.csv"),
+        keep.join("\n") + "\n" + &cut[..cut.len() / 2],
+    )
+    .unwrap();
+    std::fs::write(
+        options.out.join("fig10.partial.plan"),
+        format!(
+            "{} {}\n",
+            part["version"].as_str().unwrap(),
+            part["plan"].as_str().unwrap()
+        ),
+    )
+    .unwrap();
     let resumed = fig10(&file, &options);
     assert_eq!(outcomes(&resumed), outcomes(&whole));
     // The finished trials were not run again: their wall times are the first run's.
@@ -337,6 +355,77 @@ fn an_interrupted_fig10_resumes_without_redoing_finished_trials() {
         }
     }
     assert!(!options.out.join("fig10.partial.csv").exists());
+    assert!(!options.out.join("fig10.partial.plan").exists());
+}
+
+#[test]
+fn a_resume_refuses_rows_made_with_other_settings() {
+    let dir = scratch_dir("fig10_resume_other");
+    let options = quick(&dir.join("out"));
+    fig10(&fig10_file(&dir, "0.0", 1.0, 2), &options);
+    // The same radii, trials and seeds, but trials of another length: none of its rows count.
+    let longer = fig10_file(&dir, "0.0", 2.0, 2);
+    let err = experiments::fig10::run(&default_config(), &longer, &options).unwrap_err();
+    assert!(err.contains("fig10.csv") && err.contains("other settings"), "{err}");
+    // Another scenario is another plan too.
+    let mut fewer = default_config();
+    fewer.scenario.creatures[0].count -= 1;
+    let same = dir.join("fig10.ron");
+    fig10_file(&dir, "0.0", 1.0, 2);
+    let err = experiments::fig10::run(&fewer, &same, &options).unwrap_err();
+    assert!(err.contains("other settings"), "{err}");
+    // A run of the same plan with more trials takes up the finished ones.
+    fig10(&fig10_file(&dir, "0.0", 1.0, 3), &options);
+}
+
+#[test]
+fn a_merge_takes_only_whole_parts_of_one_run() {
+    let dir = scratch_dir("fig10_merge_checked");
+    let file = fig10_file(&dir, "0.0", 1.0, 4);
+    let mut options = quick(&dir.join("x"));
+    let mut parts = Vec::new();
+    for k in 1..=2 {
+        options.out = dir.join(format!("shard{k}"));
+        options.shard = Shard { k, n: 2 };
+        fig10(&file, &options);
+        parts.push(options.out.clone());
+    }
+    let merge = |parts: &[PathBuf]| experiments::fig10::merge(parts, &dir.join("merged"));
+    merge(&parts).expect("two whole parts of one run merge");
+
+    let err = merge(&parts[..1]).unwrap_err();
+    assert!(err.contains("shard 2/2 is missing"), "{err}");
+
+    // A part made by another plan (trials of another length).
+    let other = fig10_file(&dir, "0.0", 2.0, 4);
+    options.out = dir.join("other2");
+    fig10(&other, &options);
+    let err = merge(&[parts[0].clone(), options.out.clone()]).unwrap_err();
+    assert!(
+        err.contains("other2") && err.contains("plan") && err.contains("not parts of one run"),
+        "{err}"
+    );
+
+    // A part cut short, or edited, since it was written.
+    let csv = parts[1].join("fig10.csv");
+    let text = std::fs::read_to_string(&csv).unwrap();
+    std::fs::write(&csv, &text[..text.len() - 10]).unwrap();
+    let err = merge(&parts).unwrap_err();
+    assert!(
+        err.contains("shard2/fig10.csv") && err.contains("changed since it was written"),
+        "{err}"
+    );
+    let edited = text.replacen(",41,", ",42,", 1);
+    assert_ne!(edited, text, "shard 2 holds trial 1, seed 41");
+    std::fs::write(&csv, edited).unwrap();
+    let err = merge(&parts).unwrap_err();
+    assert!(err.contains("changed since it was written"), "{err}");
+
+    // A folder without its part record says what is missing.
+    std::fs::write(&csv, &text).unwrap();
+    std::fs::remove_file(parts[1].join("fig10.part.json")).unwrap();
+    let err = merge(&parts).unwrap_err();
+    assert!(err.contains("fig10.part.json"), "{err}");
 }
 
 #[test]
@@ -353,4 +442,66 @@ fn a_broken_experiment_file_is_refused_with_the_file_and_the_field() {
     std::fs::write(&file, format!("(full: {good}, quick: (radii_m: [1.0]))")).unwrap();
     let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir)).unwrap_err();
     assert!(err.contains("fig10.ron") && err.contains("quick"), "{err}");
+}
+
+#[test]
+fn an_experiment_refuses_a_kind_without_the_levels_it_compares_rather_than_mislabel_them() {
+    let dir = scratch_dir("experiment_missing_level");
+    let mut no_table = default_config();
+    let biped = no_table.kind_index("biped").unwrap();
+    no_table.gaits[biped] = None;
+    let mut no_rigid = default_config();
+    no_rigid.kinds[biped].rigid = None;
+
+    let file = assets_root().join("experiments/step_response.ron");
+    let steps = std::fs::read_to_string(&file).unwrap();
+    let biped_steps = dir.join("step_response.ron");
+    std::fs::write(
+        &biped_steps,
+        steps.replacen("creature: \"hopper\"", "creature: \"biped\"", 1),
+    )
+    .unwrap();
+    let err = step_response::run(&no_table, &biped_steps, &dir).unwrap_err();
+    assert!(
+        err.contains("`creature`") && err.contains("\"biped\" has no hybrid level") && err.contains("gait_table"),
+        "{err}"
+    );
+    let err = step_response::run(&no_rigid, &biped_steps, &dir).unwrap_err();
+    assert!(
+        err.contains("no rigid level") && err.contains("`rigid` section"),
+        "{err}"
+    );
+    step_response::run(&no_table, &file, &dir).expect("the hopper has both levels");
+
+    for (name, config, missing) in [
+        ("fig10", &no_table, "no hybrid level"),
+        ("fig8", &no_rigid, "no rigid level"),
+        ("fig9", &no_table, "no hybrid level"),
+        ("budget", &no_rigid, "no rigid level"),
+    ] {
+        let err = experiments::run_named(
+            name,
+            config,
+            &experiments::default_file(&assets_root(), name),
+            &quick(&dir),
+        )
+        .unwrap_err();
+        assert!(
+            err.contains(name) && err.contains("\"biped\"") && err.contains(missing),
+            "{err}"
+        );
+    }
+    assert!(!dir.join("fig10.csv").exists(), "nothing is written");
+}
+
+#[test]
+fn a_step_response_longer_than_the_models_keep_time_is_refused_not_shortened() {
+    let dir = scratch_dir("step_response_long");
+    let file = dir.join("long.ron");
+    let steps = std::fs::read_to_string(assets_root().join("experiments/step_response.ron")).unwrap();
+    let at = steps.find("duration_s:").unwrap();
+    let end = at + steps[at..].find(',').unwrap();
+    std::fs::write(&file, format!("{}duration_s: 1e9{}", &steps[..at], &steps[end..])).unwrap();
+    let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
+    assert!(err.contains("`duration_s`") && err.contains("10000"), "{err}");
 }
