@@ -11,7 +11,7 @@ use simlod::config::{ArenaConfig, ConfigError, CreatureDef, RigidJoints, Scenari
 /// A copy of the shipped assets in a scratch folder, with one file replaced.
 pub(crate) fn assets_with(test: &str, file: &str, contents: &[u8]) -> PathBuf {
     let dir = scratch_dir(test);
-    for sub in ["", "creatures", "scenarios", "rules", "gaits"] {
+    for sub in ["", "creatures", "scenarios", "rules", "gaits", "experiments"] {
         std::fs::create_dir_all(dir.join(sub)).unwrap();
         for entry in std::fs::read_dir(assets_root().join(sub)).unwrap().flatten() {
             if entry.path().is_file() {
