@@ -31,6 +31,8 @@
 //!
 //! The `examples/` folder has four runnable programs, and `docs/guide/` the user guide.
 
+#![warn(missing_docs)]
+
 /// Runs a closure over every item of a query, across threads only when there are enough
 /// creatures to pay for waking them.
 macro_rules! for_each_creature {
@@ -101,12 +103,19 @@ use config::SimConfig;
 /// The stages of one simulation tick, in the paper's order. Declared once, here.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SimStage {
+    /// Spatial index of creatures; the puck's state (runs at each decision).
     Sense,
+    /// Each creature's desired velocity: flee the puck, avoid walls and others (at each decision).
     Steer,
+    /// The level each creature wants: areas of influence, the camera rule, or the budget (paper 3.4).
     SelectLod,
+    /// A change of level, in the flight window or at once on a collision.
     Switch,
+    /// Each creature's model at its level (paper 3.1-3.3).
     Step,
+    /// Collisions with the puck, walls and other creatures; falls.
     Observe,
+    /// Fallen creatures removed and respawned; the counters and the clock.
     Outcome,
 }
 

@@ -657,7 +657,7 @@ fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran: &WhatRan)
     );
     println!("collisions: {}", join(&s.collisions));
     println!(
-        "creatures that collided with the puck or a wall: {} (with each: {})",
+        "creatures that collided with the puck or a wall: {} (by what they hit, one creature counted under each it hit: {})",
         s.creatures_collided,
         join(&s.creatures_collided_with)
     );

@@ -224,6 +224,7 @@ pub fn inside_assets(path: &str) -> Result<(), &'static str> {
 
 /// Range checks of a deserialized asset file.
 pub trait Validate {
+    /// Records every problem with `self` in `v`, each under its field's path.
     fn validate(&self, v: &mut Validator);
 }
 

@@ -39,11 +39,13 @@ pub struct BudgetSettings {
     pub budget_rules: String,
     /// Length of each trial.
     pub seconds: f32,
+    /// Trials of the trade-off (each setting runs every trial); `--trials` overrides it.
     pub trials: u32,
     /// Trial `i` runs with seed `first_seed + i`.
     pub first_seed: u64,
     /// The crowded game: creatures (the scenario's mix, its court grown to the same density).
     pub crowd_creatures: u32,
+    /// Length of the crowded game, s (each policy's game is this long).
     pub crowd_seconds: f32,
     /// The frame budget of the crowded game's budget policy.
     pub crowd_budget_ms: f32,
@@ -91,7 +93,10 @@ impl Validate for BudgetSettings {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BudgetPoint {
+    /// The frame budget: ms of simulation per 1/30 s frame.
     pub frame_budget_ms: f32,
+    /// The least benefit per ms a level must bring to be bought: 0 (the default) makes the budget
+    /// a target, above 0 a ceiling.
     #[serde(default)]
     pub least_benefit_per_ms: f32,
 }
@@ -564,6 +569,8 @@ fn crowd(config: &SimConfig, rules: &Rules, s: &BudgetSettings) -> Vec<Crowd> {
     .collect()
 }
 
+/// Runs the budget experiment from `file`: the trade-off trials on `--jobs` threads, then the
+/// crowded game; writes its CSV, plot, JSON and report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: BudgetSettings = load_settings(file, options)?;
     let s = BudgetSettings {

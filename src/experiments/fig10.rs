@@ -27,6 +27,7 @@ pub struct Fig10Settings {
     pub rules: String,
     /// Length of each trial.
     pub seconds: f32,
+    /// Trials at each radius; `--trials` overrides it.
     pub trials: u32,
     /// Trial `i` runs with seed `first_seed + i`.
     pub first_seed: u64,
@@ -145,21 +146,34 @@ fn read_part(dir: &Path) -> Result<(Part, Vec<Row>), String> {
 /// One trial at one radius, beside the identical trial all rigid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
+    /// The puck's radius of influence, metres.
     pub puck_radius_m: f32,
+    /// The trial's number, from 0.
     pub trial: u32,
+    /// The seed of the trial's initial conditions (`first_seed + trial`).
     pub seed: u64,
+    /// Length of the trial, simulated seconds.
     pub seconds: f32,
+    /// The level rules file the trial ran under (under the assets folder).
     pub rules: String,
+    /// Creatures that collided with the puck or a wall under the influence policy (figure 10's measure).
     pub collided: u64,
+    /// The same count in the identical trial all rigid.
     pub collided_all_rigid: u64,
+    /// Creatures that fell under the influence policy.
     pub falls: u64,
+    /// Creatures that fell in the identical trial all rigid.
     pub falls_all_rigid: u64,
+    /// Creatures at the rigid level, averaged over the trial's steering decisions.
     pub mean_rigid: f64,
+    /// Wall-clock seconds the trial took under the influence policy.
     pub wall_s: f64,
+    /// Wall-clock seconds the identical trial took all rigid.
     pub wall_s_all_rigid: f64,
 }
 
 impl Row {
+    /// Figure 10's y value for this trial: creatures collided under the influence policy less all rigid.
     pub fn difference(&self) -> i64 {
         self.collided as i64 - self.collided_all_rigid as i64
     }
@@ -273,6 +287,8 @@ fn run_trial(config: &SimConfig, rules: &LevelRules, s: &Fig10Settings, trial: u
         .collect()
 }
 
+/// Runs figure 10 from `file`: this shard's trials on `--jobs` threads, resuming an interrupted
+/// run; writes its CSV, plot, JSON and report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: Fig10Settings = load_settings(file, options)?;
     let rules: LevelRules = load_file(&options.assets.join(&s.rules))

@@ -22,6 +22,7 @@ pub const PAPER_ENDS: [(f64, f64); 2] = [(0.0, 112.0), (100.0, 12.0)];
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Fig7Settings {
+    /// The creature kind measured (the scenario's creatures are all made this kind).
     pub creature: String,
     /// The percentages of rigid creatures measured.
     pub rigid_percent: Vec<u32>,
@@ -29,7 +30,9 @@ pub struct Fig7Settings {
     pub search_from: u32,
     /// Halvings of the search's last gap (it stops within 3 %).
     pub search_steps: u32,
+    /// Frames run before timing starts, in each run of a count.
     pub warmup_frames: u32,
+    /// Frames timed in each run; the run's measure is their median.
     pub frames: u32,
     /// Runs per count tried; a count fits when the median of their median frames does.
     pub trials: u32,
@@ -80,6 +83,8 @@ fn mixed_frame_seconds(base: &SimConfig, n: u32, percent: u32, warmup: usize, fr
     median_frame_seconds_of(&mut sim, warmup, frames)
 }
 
+/// Runs figure 7 from `file`: for each rigid percentage, searches for the most creatures at
+/// 30 fps; writes its CSV, plot, JSON and report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: Fig7Settings = load_settings(file, options)?;
     check_kind(config, file, "creature", &s.creature, &[Lod::Hybrid, Lod::Rigid])?;

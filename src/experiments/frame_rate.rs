@@ -26,6 +26,7 @@ pub enum SweptRadius {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RulesVariant {
+    /// The variant's name in the plot's legend and the CSV's `rules` column.
     pub name: String,
     /// Under the assets folder.
     pub file: String,
@@ -35,9 +36,13 @@ pub struct RulesVariant {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameRateSettings {
+    /// Which radius of influence is swept: the puck's (figure 8) or the camera's (figure 9).
     pub swept: SweptRadius,
+    /// The level policy the games run under.
     pub policy: LevelPolicy,
+    /// The radii swept, metres.
     pub radii_m: Vec<f32>,
+    /// The level-rules files each radius runs under, one curve each.
     pub rules: Vec<RulesVariant>,
     /// Length of each game.
     pub seconds: f32,
@@ -91,6 +96,8 @@ struct Point {
     mean_rigid: f64,
 }
 
+/// Runs figure 8 or 9 (`name`) from `file`: timed games at each radius under each rules file;
+/// writes its CSV, plot, JSON and report and returns what it says.
 pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: FrameRateSettings = load_settings(file, options)?;
     let mut variants = Vec::new();

@@ -39,6 +39,7 @@ use crate::outcome::Summary;
 /// How an experiment is run: flags of `simlod experiment`.
 #[derive(Clone, Debug)]
 pub struct Options {
+    /// The folder the experiment's CSV, plot, JSON and `report.md` are written into (`--out`).
     pub out: PathBuf,
     /// The `quick` settings of the experiment's file: small counts, seconds of work.
     pub quick: bool,
@@ -57,11 +58,14 @@ pub struct Options {
 /// The `k`-th (from 1) of `n` disjoint parts of an experiment's trials.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Shard {
+    /// Which part this is, counting from 1.
     pub k: u32,
+    /// How many parts the trials are split into.
     pub n: u32,
 }
 
 impl Shard {
+    /// All the trials: the one part of one (`--shard 1/1`).
     pub const WHOLE: Shard = Shard { k: 1, n: 1 };
 
     /// Whether unit `i` of the experiment belongs to this shard.
@@ -87,7 +91,9 @@ impl std::str::FromStr for Shard {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ExperimentFile<S> {
+    /// The settings of a full run.
     pub full: S,
+    /// The settings of a `--quick` run: small counts, seconds of work.
     pub quick: S,
 }
 
@@ -226,9 +232,11 @@ pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, String> 
 /// section on it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ExperimentRecord {
+    /// The experiment's name, as `simlod experiment` takes it (e.g. `fig10`).
     pub experiment: String,
     /// The command that regenerates it.
     pub command: String,
+    /// Its summary figures, as the experiment wrote them (different for each experiment).
     pub summary: serde_json::Value,
     /// Markdown: what the paper reports, what we measured, how they compare.
     pub report: String,
@@ -260,8 +268,15 @@ impl ExperimentRecord {
             .map(|f| f.to_string())
             .chain([format!("{name}.json")])
             .collect();
+        let smoke_test = if self.smoke_test {
+            format!(
+                "{name}: SMOKE TEST (--quick): small counts that check the pipeline; its numbers are not findings\n"
+            )
+        } else {
+            String::new()
+        };
         Ok(format!(
-            "{}\nwrote {} and {report} in {}\n",
+            "{smoke_test}{}\nwrote {} and {report} in {}\n",
             self.report.trim_end(),
             written.join(", "),
             out.display()
@@ -269,7 +284,6 @@ impl ExperimentRecord {
     }
 }
 
-/// The median of some values (NaN if there are none).
 /// The mean of `values` and their sample variance (0 for a single value).
 pub fn mean_and_variance(values: &[f64]) -> (f64, f64) {
     let n = values.len() as f64;
@@ -282,6 +296,7 @@ pub fn mean_and_variance(values: &[f64]) -> (f64, f64) {
     (mean, variance)
 }
 
+/// The median of some values (NaN if there are none).
 pub fn median_of(values: impl IntoIterator<Item = f64>) -> f64 {
     let v: Vec<f64> = values.into_iter().collect();
     if v.is_empty() {

@@ -19,18 +19,23 @@ pub enum Mark {
     Points,
 }
 
+/// One curve or set of points in a panel, with its legend label.
 #[derive(Clone, Debug)]
 pub struct Series {
+    /// The series' name in the legend.
     pub label: String,
+    /// The (x, y) points, in the panel's units.
     pub points: Vec<(f64, f64)>,
     /// Half-heights of error bars, one per point.
     pub errors: Option<Vec<f64>>,
+    /// How the series is drawn: a line, a dashed line or points only.
     pub mark: Mark,
     /// Index into the palette.
     pub colour: usize,
 }
 
 impl Series {
+    /// A series without error bars.
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>, mark: Mark, colour: usize) -> Self {
         Self {
             label: label.into(),
@@ -53,12 +58,17 @@ impl Series {
 /// One chart: axes with their units, series, a legend.
 #[derive(Clone, Debug, Default)]
 pub struct Panel {
+    /// The panel's title, above the chart.
     pub title: String,
+    /// The x axis's caption, with its unit.
     pub x_label: String,
+    /// The y axis's caption, with its unit.
     pub y_label: String,
+    /// Whether the y axis is logarithmic (whole decades).
     pub log_y: bool,
     /// Names for whole-number x positions (a categorical axis), if any.
     pub x_names: Vec<String>,
+    /// The series drawn, each in the legend.
     pub series: Vec<Series>,
     /// Labels written beside points: (x, y, text).
     pub notes: Vec<(f64, f64, String)>,

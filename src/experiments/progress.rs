@@ -5,6 +5,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::time::Instant;
 
+/// Progress through a fixed number of units of work, shown on stderr; the bar is cleared when dropped.
 pub struct Progress {
     label: String,
     total: u64,
@@ -15,6 +16,7 @@ pub struct Progress {
 }
 
 impl Progress {
+    /// Starts counting `total` units of work under `label`.
     pub fn new(label: &str, total: u64) -> Self {
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());

@@ -21,15 +21,21 @@ use crate::lod::{LevelPolicy, Lod};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StepResponseConfig {
+    /// The creature kind run (it must have the hybrid and the rigid level).
     pub creature: String,
+    /// Length of each model's run, simulated seconds.
     pub duration_s: f32,
+    /// Where the creature starts on the court, (x, z) metres from its centre.
     pub start_m: (f32, f32),
+    /// The desired-velocity schedule, in increasing order of `at_s`.
     pub steps: Vec<VelocityStep>,
 }
 
+/// One step of figure 3's schedule: a new desired velocity from a time on.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct VelocityStep {
+    /// When the step happens, seconds from the start of the run.
     pub at_s: f32,
     /// Desired planar velocity (x, z) from `at_s` on.
     pub velocity_m_per_s: (f32, f32),
@@ -77,6 +83,7 @@ impl StepResponseConfig {
 /// One model's run, sampled once a frame (30 Hz).
 #[derive(Clone, Debug)]
 pub struct Trace {
+    /// The model's name in the CSVs and plots: `rigid` or `hybrid`.
     pub model: &'static str,
     /// (time, desired velocity, state)
     pub samples: Vec<(f32, Vec2, PlanarState)>,

@@ -31,6 +31,7 @@ pub struct Table1Settings {
     pub creatures: (u32, u32, u32),
     /// Speed every creature runs at while its model alone is measured.
     pub model_speed_m_per_s: f32,
+    /// Frames run before timing starts, in each run.
     pub warmup_frames: u32,
     /// Frames timed per run; a run's figure is its median frame.
     pub frames: u32,
@@ -82,6 +83,8 @@ fn model_frame_seconds(config: SimConfig, speed: f32, warmup: usize, frames: usi
 /// the kind has no such level.
 type KindCosts = [Option<[f64; 2]>; 3];
 
+/// Runs table 1 from `file`: ms per creature per 1/30 s at each level, model alone and in the
+/// game; writes its CSV, plot, JSON and report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
     let s: Table1Settings = load_settings(file, options)?;
     for (i, kind) in s.kinds.iter().enumerate() {

@@ -16,15 +16,20 @@ use crate::SimClock;
 /// What to save, and after how many frames.
 #[derive(Clone, Debug)]
 pub struct CapturePlan {
+    /// The file written: a PNG for a screenshot, a GIF for a recording.
     pub path: PathBuf,
+    /// Frames rendered before the game quits (`--frames`), each one steering decision's time.
     pub frames: u32,
+    /// A screenshot or a recording.
     pub kind: Capture,
 }
 
 /// One picture at the end, or an animated one of the whole run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Capture {
+    /// One picture of the last frame (`--screenshot`).
     Screenshot,
+    /// An animated GIF of every `recording.every_nth_frame`-th frame (`--record`).
     Recording,
 }
 

@@ -22,7 +22,9 @@ pub struct ShowPops(pub bool);
 /// A short message on screen after a key press, with the time it goes away.
 #[derive(Resource, Debug, Default)]
 pub struct Notice {
+    /// The message, shown above the keys in the HUD.
     pub text: String,
+    /// When it goes away: seconds of real time since the game started.
     pub until_s: f32,
 }
 

@@ -40,6 +40,7 @@ pub enum DrawCreatures {
 /// The drawing of one simulated creature.
 #[derive(Component, Debug)]
 pub struct CreatureVisual {
+    /// The simulated creature drawn; the drawing is despawned when it is gone.
     pub creature: Entity,
     body: Entity,
     /// At the front of the body: which way the creature faces.

@@ -25,7 +25,9 @@ pub use capture::{Capture, CapturePlan};
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {
+    /// The scenario file to play (`--scenario`); it must lie inside the assets folder.
     pub scenario: PathBuf,
+    /// The assets folder (`--assets`), watched for edits.
     pub assets: PathBuf,
     /// Overrides the scenario's level policy.
     pub policy: Option<LevelPolicy>,

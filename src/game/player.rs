@@ -23,6 +23,7 @@ pub struct NewRound;
 /// How the player did in a round.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Score {
+    /// Simulated seconds the player's creature has stayed up this round.
     pub survived_s: f64,
     /// The player's creature's collisions with the puck, walls and creatures.
     pub collisions: u32,
@@ -33,9 +34,11 @@ pub struct Score {
 pub struct Round {
     /// Rounds started so far; round `n` is played with the scenario's seed plus `n`.
     pub number: u64,
+    /// The player's creature, once chosen (the first creature of the first kind).
     pub player: Option<Entity>,
     /// The player's score so far, or its final score once the round is over.
     pub score: Option<Score>,
+    /// Whether the round is over: the player's creature fell.
     pub over: bool,
     /// The longest time survived in any round of this session (a new round keeps it).
     pub best_survived_s: f64,

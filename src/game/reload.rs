@@ -261,6 +261,8 @@ fn apply_looks(watched: Res<Watched>, looks: Res<Assets<GameConfig>>, mut settin
     }
 }
 
+/// Hot reload: watches the asset files from startup, notes each file's problems for the HUD,
+/// and applies good edits (a new round, or new rules or looks in place).
 pub fn plugin(app: &mut App) {
     app.init_resource::<Problems>()
         .add_systems(Startup, watch_files)

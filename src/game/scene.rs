@@ -13,6 +13,7 @@ use crate::config::{SimConfig, Srgb};
 use crate::lod::Lod;
 use crate::{SimEntity, SimStart};
 
+/// A colour from `game.ron` (sRGB, each channel 0 to 1) as Bevy's.
 pub fn srgb(c: Srgb) -> Color {
     Color::srgb(c[0], c[1], c[2])
 }
@@ -20,19 +21,26 @@ pub fn srgb(c: Srgb) -> Color {
 /// The materials of the scene, recoloured in place when `game.ron` changes.
 #[derive(Resource)]
 pub struct Palette {
+    /// The ice of the court.
     pub floor: Handle<StandardMaterial>,
+    /// The court's markings on the ice.
     pub lines: Handle<StandardMaterial>,
+    /// The walls round the court.
     pub wall: Handle<StandardMaterial>,
+    /// The puck.
     pub puck: Handle<StandardMaterial>,
     /// The wedge ahead of the puck: its colour, see-through.
     pub puck_path: Handle<StandardMaterial>,
+    /// Every creature's legs and nose, whatever its level.
     pub leg: Handle<StandardMaterial>,
+    /// The ring round the player's creature (unlit), in both views.
     pub player_marker: Handle<StandardMaterial>,
     /// A creature's body, by level ([`Lod::ALL`] order).
     pub bodies: Vec<Handle<StandardMaterial>>,
 }
 
 impl Palette {
+    /// The body material of a creature at `level`.
     pub fn body(&self, level: Lod) -> Handle<StandardMaterial> {
         let i = Lod::ALL
             .iter()

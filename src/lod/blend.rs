@@ -295,6 +295,7 @@ pub struct PopSummary {
     pub velocity_m_per_s: Spread,
     /// As the models alone give it, unblended.
     pub model_metres: Spread,
+    /// As the models alone give it: the largest turn, degrees.
     pub model_degrees: Spread,
 }
 

@@ -10,8 +10,11 @@ use crate::lod::Lod;
 
 /// A key of a fixed set of three, with the name the summary prints for it.
 pub trait Key: Copy + 'static {
+    /// Every key, in the summary's order.
     const ALL: [Self; 3];
+    /// The name the summary prints.
     fn name(self) -> &'static str;
+    /// Its place in `ALL`.
     fn index(self) -> usize;
 }
 

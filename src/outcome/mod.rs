@@ -35,8 +35,11 @@ use crate::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks
 /// What a creature can collide with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Obstacle {
+    /// The giant puck.
     Puck = 0,
+    /// A wall of the court.
     Wall = 1,
+    /// Another creature.
     Creature = 2,
 }
 

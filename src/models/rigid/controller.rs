@@ -44,6 +44,7 @@ pub struct Shove(pub Vec3);
 /// Where the creature is in its step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StancePhase {
+    /// Every foot off the ground.
     Flight,
     /// Foot down, leg shortening.
     Compression,
