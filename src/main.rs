@@ -440,7 +440,8 @@ struct PlayArgs {
 #[cfg(feature = "game")]
 impl PlayArgs {
     fn play(self) -> Result<(), String> {
-        simlod::game::play(simlod::game::PlayOptions {
+        let runtime_dir = private_runtime_dir();
+        let played = simlod::game::play(simlod::game::PlayOptions {
             scenario: scenario_file(&self.assets, self.scenario.as_deref()),
             assets: self.assets,
             policy: self.policy,
@@ -453,8 +454,29 @@ impl PlayArgs {
                 };
                 Some(simlod::game::CapturePlan { path, frames, kind })
             }),
-        })
+        });
+        if let Some(dir) = runtime_dir {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+        played
     }
+}
+
+/// Where `XDG_RUNTIME_DIR` is not set (a virtual X server, a bare session), the Vulkan driver's
+/// probe for Wayland prints "error: XDG_RUNTIME_DIR is invalid" although nothing failed. The
+/// game runs on X11: a private empty folder answers the probe quietly. Set here, before any
+/// thread starts; removed when the game ends.
+#[cfg(feature = "game")]
+fn private_runtime_dir() -> Option<PathBuf> {
+    use std::os::unix::fs::DirBuilderExt;
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some() {
+        return None;
+    }
+    let dir = std::env::temp_dir().join(format!("simlod-runtime-{}", std::process::id()));
+    std::fs::DirBuilder::new().mode(0o700).create(&dir).ok()?;
+    // SAFETY: main's thread is the only one yet: nothing reads the environment concurrently.
+    unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+    Some(dir)
 }
 
 #[derive(Args)]

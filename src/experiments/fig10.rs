@@ -616,13 +616,19 @@ fn finish(
         .iter()
         .map(|p| (f64::from(p.puck_radius_m), p.mean_difference))
         .collect();
+    // The claim is about the mean: its bars are standard errors (the trials' spread over the
+    // square root of their count), not the trials' own spread.
+    let standard_errors: Vec<f64> = per_radius
+        .iter()
+        .map(|p| (p.variance_difference / p.trials.max(1) as f64).sqrt())
+        .collect();
     let mut with_bars = Series::new(
-        "influence minus all rigid (mean, bars: 1 s.d.)",
+        "influence minus all rigid (mean, bars: 1 standard error)",
         difference.clone(),
         Mark::Line,
         0,
     );
-    with_bars.errors = Some(per_radius.iter().map(|p| p.variance_difference.sqrt()).collect());
+    with_bars.errors = Some(standard_errors.clone());
     let zero = Series::new(
         "no change",
         difference.iter().map(|&(x, _)| (x, 0.0)).collect(),
@@ -650,7 +656,15 @@ fn finish(
                 title: "the trade-off: speed against outcome".into(),
                 x_label: "change in creatures collided (mean)".into(),
                 y_label: "speed-up over all rigid (wall time)".into(),
-                series: vec![Series::new("one point per radius", trade.clone(), Mark::Line, 1)],
+                series: vec![Series {
+                    x_errors: Some(standard_errors),
+                    ..Series::new(
+                        "one point per radius (bars: 1 standard error)",
+                        trade.clone(),
+                        Mark::Line,
+                        1,
+                    )
+                }],
                 notes: per_radius
                     .iter()
                     .map(|p| (p.mean_difference, p.speedup, format!("  {} m", p.puck_radius_m)))

@@ -69,6 +69,9 @@ impl Validate for FrameRateSettings {
     }
 }
 
+/// Seconds of the untimed game that warms the process before the first measured one.
+const WARM_UP_S: f64 = 2.0;
+
 /// The game of one trial: the scenario under `rules` with the swept radius set.
 pub fn trial_config(
     config: &SimConfig,
@@ -117,6 +120,12 @@ pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Re
     let total = variants.len() * s.radii_m.len() * n_trials as usize;
     let mut progress = super::Progress::new(name, total as u64);
     let mut points: BTreeMap<(usize, usize), Point> = BTreeMap::new();
+    // The first game in a process runs cold (caches, allocator, thread pool): one game of the
+    // first setting, untimed, warms them, so that the first radius is measured as the others.
+    if let (Some((_, rules)), Some(&radius)) = (variants.first(), s.radii_m.first()) {
+        let warm_up = trial_config(config, rules, &s, radius, config.scenario.seed);
+        timed_game(warm_up, f64::from(s.seconds).min(WARM_UP_S));
+    }
     for (vi, (variant, rules)) in variants.iter().enumerate() {
         for (ri, &radius) in s.radii_m.iter().enumerate() {
             let mut runs = Vec::new();

@@ -15,8 +15,19 @@ pub enum Mark {
     Line,
     /// A dashed line.
     Dashed,
-    /// Points only (the paper's numbers).
+    /// Triangles only (the paper's numbers).
     Points,
+    /// Filled circles only: values of categories, which no line joins.
+    Dots,
+    /// Hollow circles only, beside `Dots` in the same categories.
+    Rings,
+}
+
+impl Mark {
+    /// Whether a line joins the points.
+    fn joined(self) -> bool {
+        matches!(self, Mark::Line | Mark::Dashed)
+    }
 }
 
 /// One curve or set of points in a panel, with its legend label.
@@ -26,8 +37,10 @@ pub struct Series {
     pub label: String,
     /// The (x, y) points, in the panel's units.
     pub points: Vec<(f64, f64)>,
-    /// Half-heights of error bars, one per point.
+    /// Half-heights of vertical error bars, one per point.
     pub errors: Option<Vec<f64>>,
+    /// Half-widths of horizontal error bars, one per point.
+    pub x_errors: Option<Vec<f64>>,
     /// How the series is drawn: a line, a dashed line or points only.
     pub mark: Mark,
     /// Index into the palette.
@@ -41,16 +54,18 @@ impl Series {
             label: label.into(),
             points,
             errors: None,
+            x_errors: None,
             mark,
             colour,
         }
     }
 
-    /// What the series draws: each point's error bar's ends (the point twice without one).
+    /// What the series draws: each point's error bars' ends (the point itself without them).
     fn reach(&self) -> impl Iterator<Item = (f64, f64)> + '_ {
         self.points.iter().enumerate().flat_map(|(i, &(x, y))| {
             let e = self.errors.as_ref().map_or(0.0, |e| e[i]);
-            [(x, y - e), (x, y + e)]
+            let f = self.x_errors.as_ref().map_or(0.0, |e| e[i]);
+            [(x, y - e), (x, y + e), (x - f, y), (x + f, y)]
         })
     }
 }
@@ -72,6 +87,8 @@ pub struct Panel {
     pub series: Vec<Series>,
     /// Labels written beside points: (x, y, text).
     pub notes: Vec<(f64, f64, String)>,
+    /// Axes to scale: a metre across is as long as a metre up (spatial data, a path).
+    pub to_scale: bool,
 }
 
 const PALETTE: [RGBColor; 6] = [
@@ -100,18 +117,21 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         return if log { (0.1, 10.0) } else { (0.0, 1.0) };
     }
     if log {
-        (
-            10f64.powf(lo.log10().floor()),
-            10f64.powf(hi.log10().ceil().max(lo.log10().floor() + 1.0)),
-        )
+        // Whole decades, with a point near a decade's edge moved off the axis's edge.
+        let (lo, hi) = (lo.log10() - 0.05, hi.log10() + 0.05);
+        (10f64.powf(lo.floor()), 10f64.powf(hi.ceil().max(lo.floor() + 1.0)))
     } else {
         let pad = ((hi - lo) * 0.08).max(hi.abs().max(1.0) * 0.05);
         (lo - pad, hi + pad)
     }
 }
 
-/// A tick label: at most three decimals, no trailing zeros.
+/// A tick label: at most three decimals, no trailing zeros; a small number as a power of ten
+/// (the log axis of Table 1 reaches 1e-4).
 fn tidy(x: f64) -> String {
+    if x != 0.0 && x.abs() < 1e-3 {
+        return format!("{x:e}");
+    }
     let s = format!("{x:.3}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     if s == "-0" { "0".into() } else { s.into() }
@@ -152,9 +172,7 @@ const LEGEND_PT: u32 = 14;
 /// The legend's share of the plot's width and height: its longest label and its rows measured
 /// in its font, with plotters' marker column and padding around them.
 fn legend_share(area: &Area, p: &Panel) -> (f64, f64) {
-    let (w, h) = area.dim_in_pixel();
-    let plot_w = w.saturating_sub(2 * MARGIN_PX + Y_LABELS_PX).max(1);
-    let plot_h = h.saturating_sub(2 * MARGIN_PX + X_LABELS_PX + 2 * TITLE_PT).max(1);
+    let (plot_w, plot_h) = plot_size(area);
     let font: TextStyle = ("sans-serif", LEGEND_PT).into();
     let (widest, tallest) = p
         .series
@@ -166,6 +184,26 @@ fn legend_share(area: &Area, p: &Panel) -> (f64, f64) {
         (f64::from(widest + 50) / f64::from(plot_w)).min(1.0),
         (f64::from(rows * (tallest + 6) + 14) / f64::from(plot_h)).min(0.9),
     )
+}
+
+/// The plot's size inside a panel's frame, in pixels.
+fn plot_size(area: &Area) -> (u32, u32) {
+    let (w, h) = area.dim_in_pixel();
+    (
+        w.saturating_sub(2 * MARGIN_PX + Y_LABELS_PX).max(1),
+        h.saturating_sub(2 * MARGIN_PX + X_LABELS_PX + 2 * TITLE_PT).max(1),
+    )
+}
+
+/// The ranges widened, each about its middle, until a unit is as long on both axes of a plot
+/// `w` by `h` pixels.
+fn to_scale((x0, x1): (f64, f64), (y0, y1): (f64, f64), (w, h): (u32, u32)) -> ((f64, f64), (f64, f64)) {
+    let per_px = ((x1 - x0) / f64::from(w)).max((y1 - y0) / f64::from(h));
+    let about = |lo: f64, hi: f64, px: u32| {
+        let (mid, half) = ((lo + hi) / 2.0, per_px * f64::from(px) / 2.0);
+        (mid - half, mid + half)
+    };
+    (about(x0, x1, w), about(y0, y1, h))
 }
 
 /// Where `v` lies between `lo` and `hi` on the axis, 0 to 1.
@@ -227,7 +265,10 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
     if !p.x_names.is_empty() {
         (x0, x1) = (-0.5, p.x_names.len() as f64 - 0.5);
     }
-    let (y0, mut y1) = range(p.series.iter().flat_map(Series::reach).map(|q| q.1), p.log_y);
+    let (mut y0, mut y1) = range(p.series.iter().flat_map(Series::reach).map(|q| q.1), p.log_y);
+    if p.to_scale {
+        ((x0, x1), (y0, y1)) = to_scale((x0, x1), (y0, y1), plot_size(area));
+    }
     let share = legend_share(area, p);
     let (mut legend, hidden) = legend_corner(p, share, (x0, x1), (y0, y1));
     if hidden > 0 {
@@ -268,16 +309,21 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                 let colour = PALETTE[s.colour % PALETTE.len()];
                 let style = ShapeStyle::from(&colour).stroke_width(2);
                 let points = s.points.clone();
+                let ring = ShapeStyle::from(&colour).stroke_width(2);
                 let anno = match s.mark {
                     Mark::Line => chart.draw_series(LineSeries::new(points.clone(), style))?,
                     Mark::Dashed => chart.draw_series(DashedLineSeries::new(points.clone(), 8, 5, style))?,
                     Mark::Points => {
                         chart.draw_series(points.iter().map(|&q| TriangleMarker::new(q, 7, colour.filled())))?
                     }
+                    Mark::Dots => chart.draw_series(points.iter().map(|&q| Circle::new(q, 6, colour.filled())))?,
+                    Mark::Rings => chart.draw_series(points.iter().map(|&q| Circle::new(q, 6, ring)))?,
                 };
                 let anno = anno.label(&s.label);
                 match s.mark {
                     Mark::Points => anno.legend(move |(x, y)| TriangleMarker::new((x + 10, y), 6, colour.filled())),
+                    Mark::Dots => anno.legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled())),
+                    Mark::Rings => anno.legend(move |(x, y)| Circle::new((x + 10, y), 5, ring)),
                     Mark::Line => anno.legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style)),
                     Mark::Dashed => anno.legend(move |(x, y)| {
                         EmptyElement::at((x, y))
@@ -285,7 +331,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                             + PathElement::new(vec![(13, 0), (20, 0)], style)
                     }),
                 };
-                if s.mark != Mark::Points {
+                if s.mark.joined() && points.len() <= 40 {
                     chart.draw_series(points.iter().map(|&q| Circle::new(q, 3, colour.filled())))?;
                 }
                 if let Some(errors) = &s.errors {
@@ -294,6 +340,11 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                             ErrorBar::new_vertical(x, y - e, y, y + e, colour.stroke_width(2), 10)
                         }),
                     )?;
+                }
+                if let Some(errors) = &s.x_errors {
+                    chart.draw_series(points.iter().zip(errors).map(|(&(x, y), &e)| {
+                        ErrorBar::new_horizontal(y, x - e, x, x + e, colour.stroke_width(2), 10)
+                    }))?;
                 }
             }
             for (x, y, text) in &p.notes {
@@ -353,6 +404,27 @@ mod tests {
         let (corner, hidden) = legend_corner(&p, SHARE, (0.0, 1.0), (0.0, 1.0));
         assert_eq!(hidden, 0);
         assert!(!matches!(corner, SeriesLabelPosition::UpperRight));
+    }
+
+    #[test]
+    fn axes_to_scale_give_a_metre_the_same_pixels_across_and_up_and_keep_every_point() {
+        let ((x0, x1), (y0, y1)) = to_scale((0.0, 12.0), (-3.0, 3.0), (600, 500));
+        assert!(((x1 - x0) / 600.0 - (y1 - y0) / 500.0).abs() < 1e-12);
+        assert!(x0 <= 0.0 && x1 >= 12.0 && y0 <= -3.0 && y1 >= 3.0);
+    }
+
+    #[test]
+    fn a_log_axis_takes_whole_decades_with_no_point_on_its_edge() {
+        assert_eq!(range([0.001, 0.5].into_iter(), true), (1e-4, 1.0));
+        assert_eq!(range([0.002, 2.4].into_iter(), true), (1e-3, 10.0));
+    }
+
+    #[test]
+    fn a_tick_below_a_thousandth_keeps_its_value() {
+        assert_eq!(tidy(0.0001), "1e-4");
+        assert_eq!(tidy(0.001), "0.001");
+        assert_eq!(tidy(2.5), "2.5");
+        assert_eq!(tidy(0.0), "0");
     }
 
     #[test]

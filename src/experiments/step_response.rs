@@ -231,13 +231,29 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
             Mark::Line,
             i,
         ));
-        path.push(Series::new(
-            tr.model,
-            points(&|(_, _, s)| (s.position.x, s.position.y)),
-            Mark::Line,
-            i,
-        ));
+        // The first model's path is drawn dashed and last, over the other: where the two
+        // paths run together, both stay in sight.
+        path.insert(
+            0,
+            Series::new(
+                tr.model,
+                points(&|(_, _, s)| (s.position.x, s.position.y)),
+                if i == 0 { Mark::Dashed } else { Mark::Line },
+                i,
+            ),
+        );
     }
+    let ends: Vec<(f64, f64, String)> = traces
+        .iter()
+        .filter_map(|tr| {
+            let (t, _, s) = tr.samples.last()?;
+            Some((
+                f64::from(s.position.x),
+                f64::from(s.position.y),
+                format!("  {} at {t:.1} s", tr.model),
+            ))
+        })
+        .collect();
     plot::draw(
         file,
         1400,
@@ -255,6 +271,8 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
                 x_label: "x (m)".into(),
                 y_label: "z (m)".into(),
                 series: path,
+                notes: ends,
+                to_scale: true,
                 ..Panel::default()
             },
         ],

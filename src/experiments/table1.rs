@@ -140,12 +140,18 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     drop(progress);
     let names = ["point mass", "hybrid", "rigid"];
     let mut series: Vec<Series> = Vec::new();
+    // The levels are categories: no line joins them, and each series sits a little apart
+    // within its level so that none hides another.
+    let columns = 2 * s.kinds.len() + 1;
+    let offset = |j: usize| (j as f64 - (columns - 1) as f64 / 2.0) * 0.6 / columns as f64;
     for (k, (kind, ms)) in s.kinds.iter().zip(&costs).enumerate() {
-        for (m, (measure, mark)) in [("model and control alone", Mark::Line), ("whole game", Mark::Dashed)]
+        for (m, (measure, mark)) in [("model and control alone", Mark::Dots), ("whole game", Mark::Rings)]
             .into_iter()
             .enumerate()
         {
-            let points = (0..3).filter_map(|i| ms[i].map(|c| (i as f64, c[m]))).collect();
+            let points = (0..3)
+                .filter_map(|i| ms[i].map(|c| (i as f64 + offset(2 * k + m), c[m])))
+                .collect();
             series.push(Series::new(
                 format!("{kind}: {measure}"),
                 points,
@@ -156,7 +162,11 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     }
     series.push(Series::new(
         "paper's hopper (SGI R10000, 1997)",
-        PAPER_MS.iter().enumerate().map(|(i, &v)| (i as f64, v)).collect(),
+        PAPER_MS
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| (i as f64 + offset(columns - 1), v))
+            .collect(),
         Mark::Points,
         1,
     ));
@@ -171,7 +181,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             log_y: true,
             x_names: names.iter().map(|s| s.to_string()).collect(),
             series,
-            notes: vec![],
+            ..Panel::default()
         }],
         options.quick,
     )?;

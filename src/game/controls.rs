@@ -11,13 +11,26 @@ use super::scene::ColourByLevel;
 use crate::config::SimConfig;
 use crate::lod::LevelPolicy;
 
-/// The keys, as the HUD lists them.
-pub const CONTROLS: &str = "WASD / arrows steer   Enter new round   C colour by level   \
-L level policy   [ ] puck radius   - = camera radius   9 0 frame budget   P switch pops   Esc quit";
+/// The keys, as the HUD lists them: only those that do something under `policy`.
+pub fn controls_help(policy: LevelPolicy) -> String {
+    let mut keys = vec!["WASD/arrows steer", "Enter new round", "C colours", "L level policy"];
+    if policy.uses_puck_radius() {
+        keys.push("[ ] puck radius");
+    }
+    if policy.uses_camera_radius() {
+        keys.push("- = camera radius");
+    }
+    if policy.uses_frame_budget() {
+        keys.push("9 0 frame budget");
+    }
+    keys.extend(["P figures", "Esc quit"]);
+    keys.join("   ")
+}
 
-/// Whether the HUD lists the last switches' pops (a debug display).
+/// Whether the HUD shows the developer's figures: frame times, the budget's prediction against
+/// the time measured, and the last switches' pops.
 #[derive(Resource, Debug, Default)]
-pub struct ShowPops(pub bool);
+pub struct ShowFigures(pub bool);
 
 /// A short message on screen after a key press, with the time it goes away.
 #[derive(Resource, Debug, Default)]
@@ -60,7 +73,7 @@ fn read_game_keys(
     mut rounds: MessageWriter<NewRound>,
     mut exit: MessageWriter<AppExit>,
     mut colour_by_level: ResMut<ColourByLevel>,
-    mut show_pops: ResMut<ShowPops>,
+    mut show_figures: ResMut<ShowFigures>,
     settings: Res<GameSettings>,
     mut config: ResMut<SimConfig>,
     mut base: ResMut<BaseConfig>,
@@ -86,8 +99,11 @@ fn read_game_keys(
         ));
     }
     if keys.just_pressed(KeyCode::KeyP) {
-        show_pops.0 = !show_pops.0;
-        say(format!("switch pops {}", if show_pops.0 { "shown" } else { "hidden" }));
+        show_figures.0 = !show_figures.0;
+        say(format!(
+            "frame times and switch pops {}",
+            if show_figures.0 { "shown" } else { "hidden" }
+        ));
     }
     if keys.just_pressed(KeyCode::KeyL) {
         // Every policy there is, in turn, live: each creature moves to its new level in its
@@ -189,7 +205,7 @@ pub fn policy_name(policy: LevelPolicy) -> String {
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Notice>()
-        .init_resource::<ShowPops>()
+        .init_resource::<ShowFigures>()
         .add_systems(Update, (read_steering_keys, read_game_keys));
 }
 

@@ -8,14 +8,14 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use super::GameSettings;
-use super::controls::{CONTROLS, Notice, ShowPops, policy_name};
+use super::controls::{Notice, ShowFigures, controls_help, policy_name};
 use super::player::Round;
 use super::reload::Problems;
 use super::scene::{ColourByLevel, srgb};
 use crate::SimClock;
 use crate::config::SimConfig;
 use crate::lod::PopTally;
-use crate::lod::{BudgetTally, LevelPolicy, Lod};
+use crate::lod::{BudgetTally, Lod};
 use crate::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
@@ -213,30 +213,42 @@ fn stats_text(
         round.best_survived_s,
         score.collisions
     );
-    let _ = writeln!(
-        s,
-        "{:.1} fps   simulation {:.2} ms/frame",
-        timing.frames_per_s, timing.sim_ms_per_frame
-    );
     let hits: Vec<String> = counts
         .collisions
         .iter()
         .map(|(o, n)| format!("{} {n}", o.name()))
         .collect();
     let _ = writeln!(s, "collisions: {}   falls {}", hits.join(", "), counts.falls);
+    // Only what the running policy reads: its radii, or its budget.
     let rules = &config.rules;
-    let _ = write!(
-        s,
-        "level policy: {}   radius of influence: puck {:.0} m, camera {:.0} m",
-        policy_name(config.scenario.level_policy),
-        rules.influence.puck_radius_m,
-        rules.camera.radius_m
-    );
-    if config.scenario.level_policy == LevelPolicy::Budget {
+    let policy = config.scenario.level_policy;
+    let _ = write!(s, "level policy: {}", policy_name(policy));
+    if policy.uses_puck_radius() {
         let _ = write!(
             s,
-            "\nframe budget {:.1} ms per 1/30 s: predicted {:.2} ms, measured {:.2} ms{}{}",
-            rules.budget.frame_budget_ms,
+            "   puck's radius of influence {:.0} m",
+            rules.influence.puck_radius_m
+        );
+    }
+    if policy.uses_camera_radius() {
+        let _ = write!(s, "   camera's {:.0} m", rules.camera.radius_m);
+    }
+    if policy.uses_frame_budget() {
+        let _ = write!(s, "   frame budget {:.1} ms", rules.budget.frame_budget_ms);
+    }
+    if pops.is_none() {
+        return s;
+    }
+    // The developer's figures (P): the drawing's frame rate, and the simulation's own time.
+    let _ = write!(
+        s,
+        "\ndrawing {:.1} frames/s   simulation {:.2} ms of wall time a frame (sharing the cores with the drawing)",
+        timing.frames_per_s, timing.sim_ms_per_frame
+    );
+    if policy.uses_frame_budget() {
+        let _ = write!(
+            s,
+            "\nbudget per 1/30 s: the cost model predicts {:.2} ms, the simulation took {:.2} ms{}{}",
             budget.predicted_us() / 1e3,
             timing.sim_ms_per_decision,
             if rules.budget.adaptive_frames > 0.0 {
@@ -277,7 +289,7 @@ fn show_hud(
     (config, budget): (Res<SimConfig>, Res<BudgetTally>),
     problems: Res<Problems>,
     notice: Res<Notice>,
-    show_pops: Res<ShowPops>,
+    show_figures: Res<ShowFigures>,
     pops: Res<PopTally>,
     mut texts: Query<(&HudText, &mut Text, &mut Node)>,
 ) {
@@ -290,7 +302,7 @@ fn show_hud(
                     &timing,
                     &counts.0,
                     (&config, &budget),
-                    show_pops.0.then_some(&*pops),
+                    show_figures.0.then_some(&*pops),
                 ),
             ),
             HudText::Level(level) => {
@@ -298,7 +310,7 @@ fn show_hud(
                 (true, format!("{} {n}", level.name().replace('_', " ")))
             }
             HudText::Help => {
-                let mut help = CONTROLS.to_owned();
+                let mut help = controls_help(config.scenario.level_policy);
                 if real.elapsed_secs() < notice.until_s {
                     help = format!("{}\n{help}", notice.text);
                 }

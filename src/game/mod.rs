@@ -14,6 +14,7 @@ pub mod reload;
 mod scene;
 
 use bevy::asset::AssetMetaCheck;
+use bevy::log::{BoxedFmtLayer, LogPlugin};
 use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use std::path::{Path, PathBuf};
@@ -99,6 +100,18 @@ fn asset_path(assets: &Path, scenario: &Path) -> Result<String, String> {
     Ok(inside.to_string_lossy().replace('\\', "/"))
 }
 
+/// The log's format: colour codes only where stderr is a terminal (and `NO_COLOR` is not set),
+/// so a log file or a pipe gets plain text.
+fn plain_when_piped(_: &mut App) -> Option<BoxedFmtLayer> {
+    use std::io::IsTerminal;
+    let colour = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
+    Some(Box::new(
+        bevy::log::tracing_subscriber::fmt::Layer::default()
+            .with_ansi(colour)
+            .with_writer(std::io::stderr),
+    ))
+}
+
 /// Bevy's plugins for a window. Building the window's event loop panics when there is no
 /// display; that panic is caught and told in one sentence.
 fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), String> {
@@ -109,6 +122,13 @@ fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), String
                 resolution: WindowResolution::new(1280, 720),
                 ..default()
             }),
+            ..default()
+        })
+        .set(LogPlugin {
+            fmt_layer: plain_when_piped,
+            // winit's complaints about a virtual X server (no XSETTINGS, a 0 mm screen) are
+            // not the player's problem.
+            filter: format!("{},winit=error", bevy::log::DEFAULT_FILTER),
             ..default()
         })
         .set(AssetPlugin {
