@@ -129,7 +129,11 @@ fn range(values: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
 /// A tick label: at most three decimals, no trailing zeros; a small number as a power of ten
 /// (the log axis of Table 1 reaches 1e-4).
 fn tidy(x: f64) -> String {
-    if x != 0.0 && x.abs() < 1e-3 {
+    if x.abs() < 1e-12 {
+        // A tick at zero, computed with a rounding error.
+        return "0".into();
+    }
+    if x.abs() < 1e-3 {
         return format!("{x:e}");
     }
     let s = format!("{x:.3}");
@@ -260,7 +264,7 @@ fn room_for_legend((y0, y1): (f64, f64), h: f64, log: bool) -> f64 {
 }
 
 fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> {
-    let xs = p.series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
+    let xs = p.series.iter().flat_map(Series::reach).map(|q| q.0);
     let (mut x0, mut x1) = range(xs, false);
     if !p.x_names.is_empty() {
         (x0, x1) = (-0.5, p.x_names.len() as f64 - 0.5);
@@ -364,7 +368,8 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
         }};
     }
     if p.log_y {
-        body!(builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())?);
+        // A hair beyond the decades, so that plotters labels the decades at both ends.
+        body!(builder.build_cartesian_2d(x0..x1, (y0 * 0.97..y1 * 1.03).log_scale())?);
     } else {
         body!(builder.build_cartesian_2d(x0..x1, y0..y1)?);
     }
@@ -425,6 +430,7 @@ mod tests {
         assert_eq!(tidy(0.001), "0.001");
         assert_eq!(tidy(2.5), "2.5");
         assert_eq!(tidy(0.0), "0");
+        assert_eq!(tidy(-2.7e-17), "0", "a zero tick with a rounding error");
     }
 
     #[test]

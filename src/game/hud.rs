@@ -223,15 +223,15 @@ fn stats_text(
     let rules = &config.rules;
     let policy = config.scenario.level_policy;
     let _ = write!(s, "level policy: {}", policy_name(policy));
+    let mut radii = Vec::new();
     if policy.uses_puck_radius() {
-        let _ = write!(
-            s,
-            "   puck's radius of influence {:.0} m",
-            rules.influence.puck_radius_m
-        );
+        radii.push(format!("puck {:.0} m", rules.influence.puck_radius_m));
     }
     if policy.uses_camera_radius() {
-        let _ = write!(s, "   camera's {:.0} m", rules.camera.radius_m);
+        radii.push(format!("camera {:.0} m", rules.camera.radius_m));
+    }
+    if !radii.is_empty() {
+        let _ = write!(s, "   radius of influence: {}", radii.join(", "));
     }
     if policy.uses_frame_budget() {
         let _ = write!(s, "   frame budget {:.1} ms", rules.budget.frame_budget_ms);
