@@ -443,7 +443,7 @@ fn read_journal(path: &Path) -> Result<Vec<Row>, String> {
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
     let mut rows = Vec::new();
     let mut seen = BTreeSet::new();
-    let mut first: Option<(&Path, Part)> = None;
+    let mut first: Option<(&Path, Part, Shard)> = None;
     let mut shards = BTreeSet::new();
     for dir in dirs {
         let (part, part_rows) = read_part(dir)?;
@@ -451,7 +451,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
             .shard
             .parse()
             .map_err(|e| format!("{}: field `shard`: {e}", dir.join(PART_FILE).display()))?;
-        if let Some((first_dir, f)) = &first {
+        if let Some((first_dir, f, f_shard)) = &first {
             for (what, this, that) in [
                 ("simlod version", &part.version, &f.version),
                 (
@@ -460,11 +460,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
                     &f.plan,
                 ),
                 ("trial count", &part.trials.to_string(), &f.trials.to_string()),
-                (
-                    "number of shards",
-                    &shard.n.to_string(),
-                    &f.shard.split('/').nth(1).unwrap_or("").to_owned(),
-                ),
+                ("number of shards", &shard.n.to_string(), &f_shard.n.to_string()),
             ] {
                 if this != that {
                     return Err(format!(
@@ -494,12 +490,11 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
             }
             rows.push(row);
         }
-        first.get_or_insert((dir.as_path(), part));
+        first.get_or_insert((dir.as_path(), part, shard));
     }
-    let Some((first_dir, first)) = first else {
+    let Some((first_dir, first, Shard { n, .. })) = first else {
         return Err("name the folders of the parts to merge".to_owned());
     };
-    let n: u32 = first.shard.split('/').nth(1).and_then(|n| n.parse().ok()).unwrap_or(1);
     if let Some(k) = (1..=n).find(|k| !shards.contains(k)) {
         return Err(format!(
             "shard {k}/{n} is missing: merged, the parts would not be one run's {} trials",
