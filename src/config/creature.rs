@@ -50,6 +50,27 @@ pub struct CreatureDef {
     /// (paper 3.2), written by `simlod record-gait`; a kind without one is never hybrid.
     #[serde(default)]
     pub gait_table: Option<String>,
+    /// How the game tells this kind apart from the others (the simulation never reads it).
+    #[serde(default)]
+    pub look: KindLook,
+}
+
+/// A kind's look in the game, within the colouring by level: a crest on the body and its
+/// nose in the kind's own colour.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KindLook {
+    /// The crest's and the nose's colour, sRGB components from 0 to 1.
+    pub marking_srgb: [f32; 3],
+}
+
+impl Default for KindLook {
+    /// Dark grey, as the legs.
+    fn default() -> Self {
+        Self {
+            marking_srgb: [0.25, 0.25, 0.28],
+        }
+    }
 }
 
 /// One leg, from its hip on the body to its ball foot (paper figure 2): an upper leg on a
@@ -236,6 +257,13 @@ pub struct SteeringConfig {
 impl Validate for CreatureDef {
     fn validate(&self, v: &mut Validator) {
         v.kind_name("name", &self.name);
+        v.nested("look", |v| {
+            v.nested("marking_srgb", |v| {
+                for (i, x) in self.look.marking_srgb.into_iter().enumerate() {
+                    v.within(&i.to_string(), x, 0.0, 1.0);
+                }
+            });
+        });
         v.nested("body", |v| {
             v.range("radius_m", self.body.radius_m, 0.01, 10.0);
             v.range("hip_height_m", self.body.hip_height_m, 0.01, 20.0);

@@ -153,6 +153,9 @@ pub struct CreatureLook {
     /// A nose at the front of the body shows which way a creature faces: its radius as a
     /// share of the body's.
     pub nose_radius_fraction: f32,
+    /// A crest on top of the body, in the kind's colour (its file's `look`), tells the kinds
+    /// apart: its radius as a share of the body's.
+    pub crest_radius_fraction: f32,
 }
 
 /// `simlod play --record FILE.gif --frames N`: the animated picture of a round.
@@ -249,6 +252,7 @@ impl Validate for GameConfig {
             v.within("body_height_ratio", k.body_height_ratio, 0.2, 5.0);
             v.range("leg_thickness_m", k.leg_thickness_m, 0.001, 1.0);
             v.within("nose_radius_fraction", k.nose_radius_fraction, 0.05, 1.0);
+            v.within("crest_radius_fraction", k.crest_radius_fraction, 0.05, 1.0);
         });
         let r = &self.recording;
         v.nested("recording", |v| {

@@ -16,7 +16,7 @@ mod validate;
 pub use arena::{ArenaConfig, PuckConfig};
 pub use costs::{CostModel, KindCosts, LevelCosts};
 pub use creature::{
-    BodyConfig, CreatureDef, FallConfig, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints, Stance,
+    BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints, Stance,
     SteeringConfig,
 };
 pub use game::{

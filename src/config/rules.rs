@@ -14,9 +14,6 @@ pub struct LevelRules {
     pub camera: CameraRules,
     /// To leave an area a creature must be this much further out than to enter it; 0 to 1000 m.
     pub release_margin_m: f32,
-    /// To leave the camera's view a creature must be this much further outside its cone; 0
-    /// to 90 degrees.
-    pub release_margin_deg: f32,
     /// After a switch a creature keeps its level at least this long; 0 to 3600 s.
     pub min_dwell_s: f32,
     /// Start and end of the switching window, as parts of the flight phase (0 to 1).
@@ -48,10 +45,20 @@ pub struct InfluenceRules {
 pub struct CameraRules {
     /// The camera's radius of influence: in view and nearer than this, rigid; 0 to 10,000 m.
     pub radius_m: f32,
-    /// Opening angle of the view cone; 1 to 179 degrees.
+    /// Headless, the camera's vertical opening angle; 1 to 179 degrees (the game uses its
+    /// window's camera).
     pub field_of_view_deg: f32,
-    /// Headless, the camera rides this far behind the creature it follows, facing the puck; 0 to 1000 m.
+    /// Headless, the view's width over its height; 0.1 to 10.
+    pub aspect_ratio: f32,
+    /// Headless, the camera rides this far behind the creature it follows, on the side away
+    /// from the puck; 0 to 1000 m.
     pub follow_distance_m: f32,
+    /// ... this high; 0.1 to 1000 m.
+    pub follow_height_m: f32,
+    /// ... and aims at a point between the creature (0) and the puck (1); 0 to 1.
+    pub aim_toward_puck_fraction: f32,
+    /// ... at this height (below the ice tilts the view down); -1000 to 1000 m.
+    pub aim_height_m: f32,
 }
 
 /// The `budget` policy (beyond the paper's conclusion: "cost/benefit heuristics might be
@@ -112,11 +119,15 @@ impl Validate for LevelRules {
         });
         v.nested("camera", |v| {
             v.range("radius_m", self.camera.radius_m, 0.0, 10_000.0);
-            v.range("field_of_view_deg", self.camera.field_of_view_deg, 1.0, 179.0);
-            v.range("follow_distance_m", self.camera.follow_distance_m, 0.0, 1000.0);
+            let c = &self.camera;
+            v.range("field_of_view_deg", c.field_of_view_deg, 1.0, 179.0);
+            v.range("aspect_ratio", c.aspect_ratio, 0.1, 10.0);
+            v.range("follow_distance_m", c.follow_distance_m, 0.0, 1000.0);
+            v.range("follow_height_m", c.follow_height_m, 0.1, 1000.0);
+            v.within("aim_toward_puck_fraction", c.aim_toward_puck_fraction, 0.0, 1.0);
+            v.range("aim_height_m", c.aim_height_m, -1000.0, 1000.0);
         });
         v.range("release_margin_m", self.release_margin_m, 0.0, 1000.0);
-        v.range("release_margin_deg", self.release_margin_deg, 0.0, 90.0);
         v.range("min_dwell_s", self.min_dwell_s, 0.0, 3600.0);
         v.range("blend_s", self.blend_s, 0.0, 2.0);
         v.nested("budget", |v| {

@@ -140,6 +140,9 @@ pub struct DesiredVelocity(pub Vec2);
 pub struct KindParams {
     /// The footprint's radius: the collision circle below the rigid level.
     pub radius_m: f32,
+    /// What the camera rule tests against the view: the height of a sphere's centre and its
+    /// radius, holding the body and legs from the ground to a body's radius above the hips.
+    pub view_sphere_m: (f32, f32),
     /// The whole creature's mass.
     pub mass_kg: f32,
     /// The point mass's limits: the gait table's measured ones when there is a table.
@@ -194,10 +197,13 @@ impl KindParams {
             .iter()
             .map(|hip| LegPose::straight(d.body.hip_height_m + hip.y))
             .collect();
+        let half_height = (d.body.hip_height_m + d.body.radius_m) / 2.0;
+        let top_speed_m_per_s = gait.map_or(d.top_speed_m_per_s, |g| g.top_speed_m_per_s);
         Self {
             radius_m: d.body.radius_m,
+            view_sphere_m: (half_height, half_height.hypot(d.body.radius_m)),
             mass_kg: d.body.mass_kg,
-            top_speed_m_per_s: gait.map_or(d.top_speed_m_per_s, |g| g.top_speed_m_per_s),
+            top_speed_m_per_s,
             acceleration_limit_m_per_s2: gait.map_or(d.acceleration_limit_m_per_s2, |g| g.acceleration_limit_m_per_s2),
             command_acceleration_m_per_s2: d.acceleration_limit_m_per_s2,
             turn_rate_rad_per_s: d.turn_rate_deg_per_s.to_radians(),

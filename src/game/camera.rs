@@ -1,6 +1,5 @@
-//! The two views of paper figure 6: the player's view, a camera that follows the player's
-//! creature from the side away from the puck so the puck stays in view; and an overhead
-//! view of the whole court, inset in a corner of the window.
+//! The overhead view of paper figure 6: the whole court, inset in a corner of the window,
+//! with the player's view (`view.rs`) drawn on it as a fan.
 
 use bevy::camera::visibility::RenderLayers;
 use bevy::camera::{ScalingMode, Viewport};
@@ -9,16 +8,10 @@ use bevy::window::PrimaryWindow;
 
 use super::GameSettings;
 use super::creatures::OVERHEAD_ONLY;
-use super::player::Round;
 use super::scene::srgb;
-use crate::arena::{Court, PuckState};
+use super::view::{FollowCamera, ViewSystems};
+use crate::arena::Court;
 use crate::config::SimConfig;
-use crate::creature::PlanarState;
-use crate::lod::{CameraFromView, SimCamera};
-
-/// The player's view. The HUD is drawn on it.
-#[derive(Component)]
-pub struct FollowCamera;
 
 /// The overhead view of the whole court.
 #[derive(Component)]
@@ -35,25 +28,7 @@ struct ViewCone {
     shape: (f32, f32),
 }
 
-/// Where the follow camera is headed: the eye and the point it looks at.
-#[derive(Resource, Default)]
-struct FollowTarget {
-    eye: Vec3,
-    aim: Vec3,
-    /// Where the player's creature was last seen (the view stays there after a fall).
-    player: Vec2,
-    placed: bool,
-}
-
 fn spawn_cameras(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
-    commands.spawn((
-        Name::new("follow camera"),
-        FollowCamera,
-        Camera3d::default(),
-        Camera { order: 0, ..default() },
-        IsDefaultUiCamera,
-        Transform::from_xyz(0.0, 30.0, 40.0).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
     commands.spawn((
         Name::new("overhead camera"),
         OverheadCamera,
@@ -84,43 +59,6 @@ fn spawn_cameras(mut commands: Commands, mut materials: ResMut<Assets<StandardMa
         },
         BorderColor::all(Color::WHITE),
     ));
-}
-
-/// Behind the player on the line from the puck, aiming between the two; eased, so the view
-/// does not jerk with every hop.
-fn follow_player(
-    time: Res<Time>,
-    settings: Res<GameSettings>,
-    round: Res<Round>,
-    puck: Res<PuckState>,
-    creatures: Query<&PlanarState>,
-    mut target: ResMut<FollowTarget>,
-    mut camera: Single<(&mut Transform, &mut Projection), With<FollowCamera>>,
-) {
-    let c = &settings.camera;
-    if let Some(state) = round.player.and_then(|p| creatures.get(p).ok()) {
-        target.player = state.position;
-    }
-    let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
-    let away = (target.player - puck.position).normalize_or(Vec2::Y);
-    let eye = at(target.player + away * c.follow_distance_m, c.follow_height_m);
-    let aim = at(
-        target.player.lerp(puck.position, c.aim_toward_puck_fraction),
-        c.aim_height_m,
-    );
-    let ease = if target.placed {
-        1.0 - (-c.follow_rate_per_s * time.delta_secs()).exp()
-    } else {
-        1.0
-    };
-    target.eye = target.eye.lerp(eye, ease);
-    target.aim = target.aim.lerp(aim, ease);
-    target.placed = true;
-    let (transform, projection) = &mut *camera;
-    **transform = Transform::from_translation(target.eye).looking_at(target.aim, Vec3::Y);
-    if let Projection::Perspective(p) = &mut **projection {
-        p.fov = c.field_of_view_deg.to_radians();
-    }
 }
 
 /// Sizes the overhead view to the court, in the window's top right corner.
@@ -159,25 +97,6 @@ fn place_overhead(
     frame.top = px(corner.y / scale - border);
     frame.width = px(extent.x / scale + 2.0 * border);
     frame.height = px(extent.y / scale + 2.0 * border);
-}
-
-/// The camera rule (paper figure 6) sees what the player sees: the follow camera's place,
-/// direction and horizontal opening on the ground.
-fn share_view(
-    settings: Res<GameSettings>,
-    round: Res<Round>,
-    window: Single<&Window, With<PrimaryWindow>>,
-    camera: Single<&Transform, With<FollowCamera>>,
-    mut view: ResMut<SimCamera>,
-) {
-    let forward = camera.forward().as_vec3();
-    let shared = SimCamera {
-        position: camera.translation.xz(),
-        facing: forward.xz().normalize_or(Vec2::NEG_Y),
-        half_view_rad: horizontal_half_view(&settings, &window),
-        following: round.player,
-    };
-    view.set_if_neq(shared);
 }
 
 /// The horizontal half angle of the view, from the vertical field of view and the window.
@@ -228,11 +147,8 @@ fn draw_view_cone(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.init_resource::<FollowTarget>()
-        .add_systems(Startup, spawn_cameras)
-        .init_resource::<CameraFromView>()
-        .add_systems(
-            Update,
-            (follow_player, share_view, place_overhead, draw_view_cone).chain(),
-        );
+    app.add_systems(Startup, spawn_cameras).add_systems(
+        Update,
+        (place_overhead, draw_view_cone).chain().after(ViewSystems),
+    );
 }

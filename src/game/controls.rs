@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use clap::ValueEnum;
 
 use super::GameSettings;
-use super::camera::FollowCamera;
+use super::view::FollowCamera;
 use super::player::{BaseConfig, NewRound, PlayerIntent};
 use super::scene::ColourByLevel;
 use crate::config::SimConfig;

@@ -12,7 +12,7 @@ use bevy::prelude::*;
 
 use super::GameSettings;
 use super::player::Round;
-use super::scene::Palette;
+use super::scene::{Palette, srgb};
 use crate::SimClock;
 use crate::SimEntity;
 use crate::config::SimConfig;
@@ -45,6 +45,8 @@ pub struct CreatureVisual {
     body: Entity,
     /// At the front of the body: which way the creature faces.
     nose: Entity,
+    /// On top of the body, in the kind's colour.
+    crest: Entity,
     legs: Vec<Entity>,
     /// Its dot in the overhead view.
     dot: Entity,
@@ -88,16 +90,35 @@ fn spawn_visuals(
     kinds: Res<KindTable>,
     meshes: Res<PartMeshes>,
     palette: Res<Palette>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+    // One material per marking colour, shared by every creature wearing it.
+    mut markings: Local<Vec<([f32; 3], Handle<StandardMaterial>)>>,
     creatures: Query<(Entity, &Creature, &Lod), Added<Creature>>,
 ) {
     for (entity, creature, lod) in &creatures {
-        let name = &config.kinds[creature.kind].name;
+        let def = &config.kinds[creature.kind];
         let leg_count = kinds[creature.kind].legs.len();
+        let colour = def.look.marking_srgb;
+        let marking = match markings.iter().find(|(c, _)| *c == colour) {
+            Some((_, m)) => m.clone(),
+            None => {
+                let m = materials.add(StandardMaterial {
+                    base_color: srgb(colour),
+                    perceptual_roughness: 0.5,
+                    ..default()
+                });
+                markings.push((colour, m.clone()));
+                m
+            }
+        };
         let body = commands
             .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
             .id();
         let nose = commands
-            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.leg.clone())))
+            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(marking.clone())))
+            .id();
+        let crest = commands
+            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(marking)))
             .id();
         let dot = commands
             .spawn((
@@ -115,18 +136,19 @@ fn spawn_visuals(
             .collect();
         commands
             .spawn((
-                Name::new(format!("{name} {}", creature.serial)),
+                Name::new(format!("{} {}", def.name, creature.serial)),
                 SimEntity,
                 Transform::default(),
                 Visibility::default(),
                 CreaturePose::default(),
             ))
-            .add_children(&[body, nose, dot])
+            .add_children(&[body, nose, crest, dot])
             .add_children(&legs)
             .insert(CreatureVisual {
                 creature: entity,
                 body,
                 nose,
+                crest,
                 legs,
                 dot,
             });
@@ -183,6 +205,9 @@ fn apply_poses(
     let body_shape = Vec3::new(1.0, look.body_height_ratio, look.body_length_ratio);
     // Sunk a little into the front of the ellipsoid.
     let nose_at = Vec3::new(0.0, 0.0, -0.9 * look.body_length_ratio);
+    // Sunk a little into the top, flattened.
+    let crest_at = Vec3::new(0.0, 0.85 * look.body_height_ratio, 0.0);
+    let crest_shape = look.crest_radius_fraction * Vec3::new(1.0, 0.45, 1.0);
     let dot_radius = settings.inset.creature_dot_radius_m;
     for (visual, pose, mut root) in &mut roots {
         *root = pose.body;
@@ -199,6 +224,9 @@ fn apply_poses(
         if let Ok((mut nose, _)) = parts.get_mut(visual.nose) {
             *nose = Transform::from_translation(nose_at * pose.body_radius_m)
                 .with_scale(Vec3::splat(look.nose_radius_fraction * pose.body_radius_m));
+        }
+        if let Ok((mut crest, _)) = parts.get_mut(visual.crest) {
+            *crest = Transform::from_translation(crest_at * pose.body_radius_m).with_scale(crest_shape * pose.body_radius_m);
         }
         if let Ok((mut dot, material)) = parts.get_mut(visual.dot) {
             let ground = to_local.transform_point3(pose.body.translation.with_y(0.05));

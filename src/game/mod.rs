@@ -12,6 +12,7 @@ mod hud;
 pub mod player;
 pub mod reload;
 mod scene;
+pub mod view;
 
 use bevy::asset::AssetMetaCheck;
 use bevy::log::{BoxedFmtLayer, LogPlugin};
@@ -155,6 +156,7 @@ fn plugin(app: &mut App) {
     reload::plugin(app);
     scene::plugin(app);
     creatures::plugin(app);
+    view::plugin(app);
     camera::plugin(app);
     controls::plugin(app);
     hud::plugin(app);

@@ -31,7 +31,7 @@ pub struct Palette {
     pub puck: Handle<StandardMaterial>,
     /// The wedge ahead of the puck: its colour, see-through.
     pub puck_path: Handle<StandardMaterial>,
-    /// Every creature's legs and nose, whatever its level.
+    /// Every creature's legs, whatever its level.
     pub leg: Handle<StandardMaterial>,
     /// The ring round the player's creature (unlit), in both views.
     pub player_marker: Handle<StandardMaterial>,

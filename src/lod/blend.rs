@@ -160,7 +160,8 @@ pub struct SwitchProbe {
     pub from: Lod,
     /// The level entered.
     pub to: Lod,
-    /// Whether a collision forced the switch outside the flight window.
+    /// Whether the switch did not wait for the flight window: a collision forced it, or a
+    /// point mass switched off screen.
     pub forced: bool,
     /// Drawn (and by the models alone) two ticks and one tick before the switch.
     before: [Drawn; 2],
@@ -283,7 +284,8 @@ pub struct PopSummary {
     pub from: &'static str,
     /// The level entered, by name.
     pub to: &'static str,
-    /// Whether collisions forced these switches outside the flight window.
+    /// Whether these switches did not wait for the flight window (collisions, or point
+    /// masses off screen).
     pub forced: bool,
     /// How many switches of this kind.
     pub count: usize,

@@ -26,7 +26,7 @@ use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start
 use super::{LevelPolicy, Lod};
 use crate::arena::{Court, PuckState};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState, starting_gait};
+use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState, starting_gait};
 use crate::gait::GaitPose;
 use crate::sense::NeighbourGrid;
 use crate::{SimStage, SimStart};
@@ -288,7 +288,6 @@ struct Scene<'a> {
     top_speed: f32,
     /// How far away another creature can still matter.
     reach_m: f32,
-    view_cos: f32,
 }
 
 impl Scene<'_> {
@@ -348,28 +347,25 @@ impl Scene<'_> {
 
     /// How much the viewer sees of a creature: 0 out of view, 1 at the camera, halving at
     /// `view_half_distance_m`.
-    fn view(&self, s: &PlanarState) -> f32 {
-        let to = s.position - self.camera.position;
-        let distance = to.length();
-        let in_view = distance < 1e-3 || to.dot(self.camera.facing) >= distance * self.view_cos;
-        if in_view {
-            1.0 / (1.0 + distance / self.rules.view_half_distance_m)
+    fn view(&self, kind: &KindParams, s: &PlanarState) -> f32 {
+        if self.camera.sees_creature(kind, s, 0.0) {
+            1.0 / (1.0 + self.camera.ground_distance(s.position) / self.rules.view_half_distance_m)
         } else {
             0.0
         }
     }
 
     /// Benefit of each level for one creature.
-    fn benefit(&self, entity: Entity, c: &Creature, s: &PlanarState, radius: f32) -> [f32; 3] {
+    fn benefit(&self, entity: Entity, c: &Creature, s: &PlanarState, kind: &KindParams) -> [f32; 3] {
         let r = self.rules;
-        let view = self.view(s);
+        let view = self.view(kind, s);
         let hybrid = r.view_hybrid_weight * view;
         let followed = if self.camera.following == Some(entity) {
             r.player_rigid_weight
         } else {
             0.0
         };
-        let rigid = hybrid + r.view_rigid_weight * view + followed + self.contact(c, s, radius);
+        let rigid = hybrid + r.view_rigid_weight * view + followed + self.contact(c, s, kind.radius_m);
         [0.0, hybrid, rigid]
     }
 }
@@ -410,7 +406,7 @@ fn decide(
                 floor: if dwelling { lod } else { kind.levels[0] },
                 levels: &kind.levels,
                 costs: costs[c.kind],
-                benefit: scene.benefit(entity, c, s, kind.radius_m),
+                benefit: scene.benefit(entity, c, s, kind),
             }
         })
         .collect();
@@ -447,7 +443,6 @@ fn scene<'a>(
         top_speed,
         // Beyond three horizons at both creatures' top speeds, a contact is worth under 5 %.
         reach_m: 2.0 * biggest + rules.contact_margin_m + 2.0 * top_speed * 3.0 * rules.contact_horizon_s,
-        view_cos: camera.half_view_rad.min(std::f32::consts::PI).cos(),
     }
 }
 

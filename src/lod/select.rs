@@ -11,12 +11,15 @@
 //! and `r` across it: it covers the circle around the body now and around where it will be
 //! `T` later.
 //!
-//! The camera rule (figure 6): out of the view cone, point mass; in view but further than the
-//! camera's radius, hybrid; in view and within it, rigid. The headless camera rides behind a
-//! creature (the player's, else the lowest serial) looking at the puck, as in figure 9.
+//! The camera rule (figure 6): out of view, point mass; in view but further than the
+//! camera's radius, hybrid; in view and within it, rigid. "In view" is the camera's real
+//! frustum against a sphere around the creature's body and legs, grown by one hop's travel:
+//! a switch waits up to a hop for its flight window, and nothing on screen may be a point
+//! mass. The headless camera rides behind a creature (the player's, else the lowest serial)
+//! looking at the puck, as in figure 9; the game's is the window's own.
 //!
-//! Hysteresis: entering an area uses its radius; leaving it takes `release_margin_m` more,
-//! and a creature keeps a new level at least `min_dwell_s`.
+//! Hysteresis: entering an area or the view uses its size; leaving it takes
+//! `release_margin_m` more, and a creature keeps a new level at least `min_dwell_s`.
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
@@ -24,7 +27,7 @@ use bevy::prelude::*;
 use super::{LevelPolicy, Lod};
 use crate::arena::{Court, PuckState};
 use crate::config::{LevelRules, SimConfig};
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState, PlayerControlled, starting_gait};
+use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState, PlayerControlled, starting_gait};
 use crate::gait::GaitPose;
 use crate::sense::NeighbourGrid;
 use crate::{SimClock, SimStage, SimStart};
@@ -40,18 +43,87 @@ pub struct LevelChoice {
     pub switched: bool,
 }
 
-/// The camera of the camera rule, on the ground plane. Headless it follows a creature
-/// (figure 9's set-up); a window's camera sets it itself (see [`CameraFromView`]).
+/// The camera of the camera rule: its eye and its view's frustum. Headless it follows a
+/// creature (figure 9's set-up); a window's camera sets it itself (see [`CameraFromView`]).
+/// The default sees everything.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct SimCamera {
-    /// The camera's position on the ground plane.
-    pub position: Vec2,
+    /// The eye.
+    pub eye: Vec3,
     /// Unit view direction.
-    pub facing: Vec2,
-    /// Half the opening angle of the view on the ground plane.
-    pub half_view_rad: f32,
+    pub forward: Vec3,
+    /// The frustum's left, right, bottom, top and near half-spaces: `(n, w)` holds the points
+    /// `p` with `n . p + w >= 0`, `n` a unit vector. The far plane is at infinity.
+    pub frustum: [Vec4; 5],
+    /// How fast the view turns, radians per second: a creature a switch keeps waiting for
+    /// its flight window may be swept into view meanwhile.
+    pub turn_rate_rad_per_s: f32,
     /// The creature it follows.
     pub following: Option<Entity>,
+}
+
+impl SimCamera {
+    /// The camera whose projection and view give `clip_from_world`, with its eye at
+    /// `world_from_view`'s origin (Gribb and Hartmann's planes, for Bevy's reversed depth).
+    pub fn new(clip_from_world: Mat4, world_from_view: Mat4, following: Option<Entity>) -> Self {
+        let row = |i| clip_from_world.row(i);
+        let half_space = |h: Vec4| h / h.truncate().length().max(f32::MIN_POSITIVE);
+        Self {
+            eye: world_from_view.w_axis.truncate(),
+            forward: -world_from_view.z_axis.truncate().normalize_or(Vec3::NEG_Z),
+            frustum: [
+                half_space(row(3) + row(0)),
+                half_space(row(3) - row(0)),
+                half_space(row(3) + row(1)),
+                half_space(row(3) - row(1)),
+                half_space(row(3) - row(2)),
+            ],
+            turn_rate_rad_per_s: 0.0,
+            following,
+        }
+    }
+
+    /// This camera, turning at the rate it turned since `before`, `dt_s` earlier.
+    pub fn turned_since(mut self, before: &SimCamera, dt_s: f32) -> Self {
+        if dt_s > 0.0 && before.forward != Vec3::ZERO {
+            self.turn_rate_rad_per_s = before.forward.angle_between(self.forward) / dt_s;
+        }
+        self
+    }
+
+    /// A perspective camera at `eye` looking at `aim`, as Bevy's (near plane 0.1 m).
+    pub fn looking_at(eye: Vec3, aim: Vec3, vertical_fov_rad: f32, aspect_ratio: f32, following: Option<Entity>) -> Self {
+        let view_from_world = Mat4::look_at_rh(eye, aim, Vec3::Y);
+        let clip_from_view = Mat4::perspective_infinite_reverse_rh(vertical_fov_rad, aspect_ratio, 0.1);
+        Self::new(clip_from_view * view_from_world, view_from_world.inverse(), following)
+    }
+
+    /// Whether any of the sphere at `centre` of `radius` is in view.
+    pub fn sees(&self, centre: Vec3, radius: f32) -> bool {
+        self.frustum.iter().all(|h| h.truncate().dot(centre) + h.w + radius >= 0.0)
+    }
+
+    /// Whether any of a creature of this kind at `s` is on screen now.
+    pub fn shows(&self, kind: &KindParams, s: &PlanarState) -> bool {
+        let (height, radius) = kind.view_sphere_m;
+        self.sees(s.position.extend(height).xzy(), radius)
+    }
+
+    /// Whether any of a creature of this kind at `s`, grown by `margin_m`, may be on screen
+    /// within a hop, the longest a switch waits for its flight window: the creature covers
+    /// up to a hop at top speed, and the view sweeps `distance x turn` meanwhile.
+    pub fn sees_creature(&self, kind: &KindParams, s: &PlanarState, margin_m: f32) -> bool {
+        let (height, radius) = kind.view_sphere_m;
+        let hop_s = 1.0 / kind.cycles_per_s;
+        let sweep = (self.turn_rate_rad_per_s * hop_s).min(std::f32::consts::FRAC_PI_2);
+        let reach = kind.top_speed_m_per_s * hop_s + self.ground_distance(s.position) * sweep.sin();
+        self.sees(s.position.extend(height).xzy(), radius + margin_m + reach)
+    }
+
+    /// Distance on the ground from the eye.
+    pub fn ground_distance(&self, q: Vec2) -> f32 {
+        self.eye.xz().distance(q)
+    }
 }
 
 /// Present when a window's camera writes [`SimCamera`] (the game): the camera rule then
@@ -71,30 +143,26 @@ pub fn in_influence(q: Vec2, p: Vec2, v: Vec2, radius: f32, lookahead_s: f32) ->
     x * x + y * y <= 1.0
 }
 
-/// The areas' radii and the view cone, to enter them or, grown by the release margins, to
-/// stay in them (the hysteresis).
+/// The areas' radii and the view's margin, to enter them or, grown by the release margin,
+/// to stay in them (the hysteresis).
 struct Radii {
     puck: f32,
     creature: f32,
     wall: f32,
     camera: f32,
-    /// Cosine of the view cone's half angle.
-    view_cos: f32,
+    /// Added to each creature's sphere against the frustum.
+    view: f32,
 }
 
 impl Radii {
-    fn of(rules: &LevelRules, half_view_rad: f32, staying: bool) -> Self {
-        let (grow, turn) = if staying {
-            (rules.release_margin_m, rules.release_margin_deg.to_radians())
-        } else {
-            (0.0, 0.0)
-        };
+    fn of(rules: &LevelRules, staying: bool) -> Self {
+        let grow = if staying { rules.release_margin_m } else { 0.0 };
         Self {
             puck: rules.influence.puck_radius_m + grow,
             creature: rules.influence.creature_radius_m + grow,
             wall: rules.influence.wall_band_m + grow,
             camera: rules.camera.radius_m + grow,
-            view_cos: (half_view_rad + turn).min(std::f32::consts::PI).cos(),
+            view: grow,
         }
     }
 }
@@ -122,6 +190,7 @@ impl DecisionInputs<'_> {
             court: &self.court,
             grid: &self.grid,
             camera: &self.camera,
+            kinds: &self.kinds,
             reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
         }
     }
@@ -133,6 +202,7 @@ struct LevelInputs<'a> {
     court: &'a Court,
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
+    kinds: &'a KindTable,
     reach_m: f32,
 }
 
@@ -160,9 +230,9 @@ impl LevelInputs<'_> {
         }
     }
 
-    fn camera_level(&self, s: &PlanarState, r: &Radii) -> Lod {
-        let distance = s.position.distance(self.camera.position);
-        match (in_view(self.camera, s.position, r.view_cos), distance <= r.camera) {
+    fn camera_level(&self, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
+        let in_view = self.camera.sees_creature(&self.kinds[c.kind], s, r.view);
+        match (in_view, self.camera.ground_distance(s.position) <= r.camera) {
             (false, _) => Lod::PointMass,
             (true, false) => Lod::Hybrid,
             (true, true) => Lod::Rigid,
@@ -172,22 +242,16 @@ impl LevelInputs<'_> {
     fn level(&self, policy: LevelPolicy, c: &Creature, s: &PlanarState, r: &Radii) -> Lod {
         match policy {
             LevelPolicy::Influence => self.influence_level(c, s, r),
-            LevelPolicy::Camera => self.camera_level(s, r),
-            LevelPolicy::Combined => self.influence_level(c, s, r).max(self.camera_level(s, r)),
+            LevelPolicy::Camera => self.camera_level(c, s, r),
+            LevelPolicy::Combined => self.influence_level(c, s, r).max(self.camera_level(c, s, r)),
             fixed => fixed.initial_level(&Lod::ALL),
         }
     }
 }
 
-/// Whether `q` lies in the camera's view cone, of half angle `acos(view_cos)`.
-fn in_view(camera: &SimCamera, q: Vec2, view_cos: f32) -> bool {
-    let to = q - camera.position;
-    let distance = to.length();
-    distance < 1e-3 || to.dot(camera.facing) >= distance * view_cos
-}
-
 /// Moves the headless camera behind the creature it follows, facing the puck.
 fn place_camera(
+    clock: Res<SimClock>,
     config: Res<SimConfig>,
     puck: Res<PuckState>,
     mut camera: ResMut<SimCamera>,
@@ -204,15 +268,19 @@ fn place_camera(
         }),
     };
     let Some((entity, state)) = followed else { return };
+    let c = &config.rules.camera;
     let facing = (puck.position - state.position)
         .try_normalize()
         .unwrap_or(state.heading);
-    *camera = SimCamera {
-        position: state.position - facing * config.rules.camera.follow_distance_m,
-        facing,
-        half_view_rad: config.rules.camera.field_of_view_deg.to_radians() / 2.0,
-        following: Some(entity),
-    };
+    let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
+    let placed = SimCamera::looking_at(
+        at(state.position - facing * c.follow_distance_m, c.follow_height_m),
+        at(state.position.lerp(puck.position, c.aim_toward_puck_fraction), c.aim_height_m),
+        c.field_of_view_deg.to_radians(),
+        c.aspect_ratio,
+        Some(entity),
+    );
+    *camera = placed.turned_since(&camera, 1.0 / clock.tick_hz as f32);
 }
 
 /// Whether every creature is at the level a fixed policy gives it, so that selecting and
@@ -236,7 +304,7 @@ pub(super) fn select_levels(
     mut settled: ResMut<LevelsSettled>,
     mut creatures: Query<(&Creature, &Lod, &PlanarState, &mut LevelChoice)>,
 ) {
-    let (clock, config, kinds, camera) = (&inputs.clock, &inputs.config, &inputs.kinds, &inputs.camera);
+    let (clock, config, kinds) = (&inputs.clock, &inputs.config, &inputs.kinds);
     let policy = config.scenario.level_policy;
     // The budget policy chooses for all creatures at once (`budget.rs`).
     if !clock.is_decision_tick() || policy == LevelPolicy::Budget {
@@ -244,10 +312,7 @@ pub(super) fn select_levels(
     }
     let rules = &config.rules;
     let levels = inputs.rules();
-    let (enter, leave) = (
-        Radii::of(rules, camera.half_view_rad, false),
-        Radii::of(rules, camera.half_view_rad, true),
-    );
+    let (enter, leave) = (Radii::of(rules, false), Radii::of(rules, true));
     let now = clock.seconds() as f32;
     for_each_creature!(config.scenario.creature_count(), creatures, |(
         c,
@@ -299,10 +364,10 @@ pub(super) fn start_at_selected_levels(
         &mut LevelChoice,
     )>,
 ) {
-    let (clock, config, kinds, camera) = (&inputs.clock, &inputs.config, &inputs.kinds, &inputs.camera);
+    let (clock, config, kinds) = (&inputs.clock, &inputs.config, &inputs.kinds);
     let policy = config.scenario.level_policy;
     let levels = inputs.rules();
-    let enter = Radii::of(&config.rules, camera.half_view_rad, false);
+    let enter = Radii::of(&config.rules, false);
     for (entity, c, &lod, s, mut gait, mut pose, mut choice) in &mut creatures {
         let kind = &kinds[c.kind];
         let level = if policy.is_dynamic() {
@@ -352,27 +417,32 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_creature_in_view_stays_in_view_until_it_is_the_margin_outside_the_cone() {
-        let mut rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
-        rules.release_margin_deg = 10.0;
-        let camera = SimCamera {
-            facing: Vec2::X,
-            half_view_rad: 30f32.to_radians(),
-            ..default()
-        };
-        let at = |deg: f32| Vec2::from_angle(deg.to_radians()) * 20.0;
-        let entering = Radii::of(&rules, camera.half_view_rad, false);
-        let staying = Radii::of(&rules, camera.half_view_rad, true);
-        // 5 degrees outside the cone: not in view to enter, still in view to stay.
-        assert!(in_view(&camera, at(29.0), entering.view_cos));
-        assert!(!in_view(&camera, at(35.0), entering.view_cos));
-        assert!(in_view(&camera, at(35.0), staying.view_cos));
-        assert!(in_view(&camera, at(-35.0), staying.view_cos));
-        // Past the margin it leaves; with no margin, at once.
-        assert!(!in_view(&camera, at(41.0), staying.view_cos));
-        rules.release_margin_deg = 0.0;
-        let no_margin = Radii::of(&rules, camera.half_view_rad, true);
-        assert!(!in_view(&camera, at(31.0), no_margin.view_cos));
+    fn a_creature_in_view_stays_in_view_until_it_is_the_margin_outside_the_frustum() {
+        // Eye 1.5 m up looking along +x; 90 degrees wide at aspect 1.
+        let camera = SimCamera::looking_at(Vec3::new(0.0, 1.5, 0.0), Vec3::new(10.0, 1.5, 0.0), 90f32.to_radians(), 1.0, None);
+        let side = |z: f32| Vec3::new(10.0, 1.5, z);
+        // The right edge is at z = 10 m at x = 10 m; the plane's distance is (z - 10) / sqrt 2.
+        assert!(camera.sees(side(9.9), 0.0));
+        assert!(!camera.sees(side(10.1), 0.0));
+        assert!(camera.sees(side(10.0 + 1.4), 1.0));
+        assert!(!camera.sees(side(10.0 + 1.5), 1.0));
+        assert!(camera.sees(side(-9.9), 0.0) && !camera.sees(side(-10.1), 0.0));
+        // Above and below, and behind the eye.
+        assert!(!camera.sees(Vec3::new(10.0, 12.0, 0.0), 0.0));
+        assert!(!camera.sees(Vec3::new(10.0, -9.0, 0.0), 0.0));
+        assert!(!camera.sees(Vec3::new(-1.0, 1.5, 0.0), 0.5));
+        assert!(camera.sees(Vec3::new(1000.0, 1.5, 0.0), 0.0));
+        // A default camera sees everything.
+        assert!(SimCamera::default().sees(Vec3::new(-1e4, 5.0, 3.0), 0.0));
+    }
+
+    #[test]
+    fn staying_in_view_takes_the_release_margin_more_than_entering() {
+        let rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
+        let (enter, leave) = (Radii::of(&rules, false), Radii::of(&rules, true));
+        assert_eq!(enter.view, 0.0);
+        assert_eq!(leave.view, rules.release_margin_m);
+        assert_eq!(leave.camera - enter.camera, rules.release_margin_m);
     }
 
     #[test]

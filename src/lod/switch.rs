@@ -1,7 +1,8 @@
 //! Switch: a change of level waits for the flight-phase window (paper 3.4: "we achieve a
 //! smooth transition by allowing switching only during a particular part of the flight phase
 //! of the running cycle"). A collision cannot wait: a creature below the rigid level that
-//! collides switches to rigid at once.
+//! collides switches to rigid at once. Nor need a point mass off screen wait: no one sees it
+//! switch, and the view may be turning toward it.
 //!
 //! The state every level shares is carried across: position, velocity, heading, gait phase
 //! and pose (they live on the creature entity, not in a model). The switch knows nothing of
@@ -11,7 +12,7 @@
 use bevy::prelude::*;
 
 use super::blend::{Drawn, DrawnBefore, SwitchBlend, SwitchProbe};
-use super::select::{LevelChoice, levels_may_change};
+use super::select::{LevelChoice, SimCamera, levels_may_change};
 use super::{LevelPolicy, Lod};
 use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
 use crate::gait::GaitPose;
@@ -29,8 +30,8 @@ pub struct LevelSwitched {
     pub from: Lod,
     /// The level it entered.
     pub to: Lod,
-    /// How far through its flight phase it was (0 lift-off, 1 touchdown); `None` when a
-    /// collision forced the switch.
+    /// How far through its flight phase it was (0 lift-off, 1 touchdown); `None` when the
+    /// switch did not wait for the window (a collision, or a point mass off screen).
     pub flight_progress: Option<f32>,
     /// Simulated seconds at the switch.
     pub at_s: f32,
@@ -61,6 +62,7 @@ fn switch_levels(
     clock: Res<SimClock>,
     config: Res<crate::config::SimConfig>,
     kinds: Res<KindTable>,
+    camera: Res<SimCamera>,
     mut tally: ResMut<SwitchTally>,
     mut switched: MessageWriter<LevelSwitched>,
     mut creatures: Query<(
@@ -98,7 +100,9 @@ fn switch_levels(
         let model = Drawn::of(state, pose);
         let seen = (blend.map_or(model, |b| b.apply(&model, now)), model);
         let progress = gait.flight_progress();
-        if !forced && !progress.is_some_and(|p| (open..=close).contains(&p)) {
+        let unseen = lod == Lod::PointMass && !camera.shows(kind, state);
+        let skips_window = forced || unseen;
+        if !skips_window && !progress.is_some_and(|p| (open..=close).contains(&p)) {
             before.0 = Some(seen);
             continue;
         }
@@ -114,7 +118,7 @@ fn switch_levels(
         });
         commands.entity(entity).insert((
             target,
-            SwitchProbe::new(lod, target, forced, [earlier.0, seen.0], [earlier.1, seen.1]),
+            SwitchProbe::new(lod, target, skips_window, [earlier.0, seen.0], [earlier.1, seen.1]),
         ));
         tally.switches.count(lod, target);
         switched.write(LevelSwitched {
@@ -122,7 +126,7 @@ fn switch_levels(
             serial: creature.serial,
             from: lod,
             to: target,
-            flight_progress: if forced { None } else { progress },
+            flight_progress: if skips_window { None } else { progress },
             at_s: now,
         });
         *choice = LevelChoice {

@@ -150,6 +150,7 @@ pub(crate) mod tests {
     pub(crate) fn kind() -> KindParams {
         KindParams {
             radius_m: 0.3,
+            view_sphere_m: (0.6, 2.2),
             mass_kg: 10.0,
             top_speed_m_per_s: 3.0,
             acceleration_limit_m_per_s2: 2.0,

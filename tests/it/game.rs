@@ -335,3 +335,86 @@ fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
     );
     assert_eq!(app.world().resource::<Round>().number, 0, "the round runs on");
 }
+
+#[test]
+fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_point_mass() {
+    use bevy::camera::CameraProjectionPlugin;
+    use bevy::camera::primitives::{Frustum, Sphere};
+    use bevy::window::{ExitCondition, WindowPlugin, WindowResolution};
+    use simlod::creature::{Creature, KindTable};
+    use simlod::gait::GaitPose;
+    use simlod::game::view::FollowCamera;
+    use simlod::lod::Lod;
+
+    let mut config = default_config();
+    config.scenario.level_policy = LevelPolicy::Camera;
+    let ticks_per_frame = config.scenario.ticks_per_decision();
+    // The game's view and Bevy's own camera, whose frustum the renderer culls with, in a
+    // 1280 by 720 window that no display shows.
+    let looks: GameConfig = load_file(&assets_root().join("game.ron")).unwrap();
+    let mut app = App::new();
+    app.add_plugins((MinimalPlugins, SimPlugin { config }))
+        .add_plugins((
+            WindowPlugin {
+                primary_window: Some(Window {
+                    resolution: WindowResolution::new(1280, 720),
+                    ..default()
+                }),
+                exit_condition: ExitCondition::DontExit,
+                close_when_requested: false,
+                ..default()
+            },
+            CameraProjectionPlugin,
+        ))
+        .insert_resource(GameSettings(looks))
+        .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_frame));
+    simlod::game::player::plugin(&mut app);
+    simlod::game::view::plugin(&mut app);
+    app.finish();
+    app.cleanup();
+    app.update();
+    // The render area's shape, as the renderer's camera system gives it.
+    let world = app.world_mut();
+    let mut projection = world.query_filtered::<&mut Projection, With<FollowCamera>>();
+    projection.single_mut(world).unwrap().update(1280.0, 720.0);
+    let (mut seen, mut unseen_point_masses) = (0, 0);
+    for frame in 0..600 {
+        // The player turns a quarter every two seconds, so the view sweeps the court.
+        let heading = Vec2::from_angle(std::f32::consts::FRAC_PI_2 * (frame / 60) as f32);
+        app.world_mut().resource_mut::<PlayerIntent>().0 = heading;
+        app.update();
+        if app.world().resource::<Round>().over {
+            app.world_mut().write_message(NewRound);
+            continue;
+        }
+        let world = app.world_mut();
+        let frustum = *world
+            .query_filtered::<&Frustum, With<FollowCamera>>()
+            .single(world)
+            .unwrap();
+        let kinds = world.resource::<KindTable>().clone();
+        for (c, s, pose, lod) in world
+            .query::<(&Creature, &PlanarState, &GaitPose, &Lod)>()
+            .iter(world)
+        {
+            let body = Sphere {
+                center: Vec3::new(s.position.x, pose.body_height_m, s.position.y).into(),
+                radius: kinds.0[c.kind].radius_m,
+            };
+            if frustum.intersects_sphere(&body, false) {
+                seen += 1;
+                assert_ne!(
+                    *lod,
+                    Lod::PointMass,
+                    "frame {frame}: creature {} at {} is on screen as a point mass",
+                    c.serial,
+                    s.position
+                );
+            } else if *lod == Lod::PointMass {
+                unseen_point_masses += 1;
+            }
+        }
+    }
+    // The test sees both sides of the rule.
+    assert!(seen > 1000 && unseen_point_masses > 1000, "{seen} seen, {unseen_point_masses} point masses out of view");
+}

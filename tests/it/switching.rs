@@ -488,20 +488,20 @@ fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests()
 struct CameraTrack(Vec<(f32, Vec2)>);
 
 fn track_camera(mut track: ResMut<CameraTrack>, clock: Res<SimClock>, camera: Res<SimCamera>) {
-    track.0.push((clock.seconds() as f32, camera.facing));
+    track.0.push((clock.seconds() as f32, camera.forward.xz()));
 }
 
 #[test]
 fn no_creature_flickers_across_the_edge_of_the_view_while_the_camera_holds_still() {
-    // The camera rule alone, no dwell and no distance margin: only the cone's margin (the
-    // shipped one; the unit test beside the rule checks the margin itself) holds. A flicker is
-    // a creature going into view and back out (or out and back in) within a second, two hops.
-    // In a game the view mostly sweeps as the followed creature turns; that is not a flicker.
-    let flickers = |margin_deg: f32| {
+    // The camera rule alone, no dwell: only the release margin (the shipped one; the unit test
+    // beside the rule checks the margin itself) holds. A flicker is a creature going into view
+    // and back out (or out and back in) within a second, two hops. In a game the view mostly
+    // sweeps as the followed creature turns; that is not a flicker.
+    let flickers = |margin_m: f32| {
         let mut config = scene(&[("hopper", 30), ("biped", 10)], LevelPolicy::Camera);
         config.rules.min_dwell_s = 0.0;
-        config.rules.release_margin_m = 0.0;
-        config.rules.release_margin_deg = margin_deg;
+        config.rules.release_margin_m = margin_m;
+        let config_radius = config.rules.camera.radius_m;
         let mut sim = watched(config);
         sim.app
             .init_resource::<CameraTrack>()
@@ -517,9 +517,10 @@ fn no_creature_flickers_across_the_edge_of_the_view_while_the_camera_holds_still
             // A collision forcing a creature rigid, and its going back, is not the view's edge.
             let windowed = |s: &LevelSwitched| s.flight_progress.is_some();
             // Nor is the view sweeping over a creature and back as the followed creature turns
-            // (many creatures at once): only a camera that turned less than the margin, which is what
-            // the margin is for.
-            let camera_still = |a: f32, b: f32| facing_at(a).angle_to(facing_at(b)).abs() < margin_deg.to_radians();
+            // (many creatures at once): only a camera that turned less than the margin subtends
+            // at the camera's radius, which is what the margin is for.
+            let still_rad = margin_m / config_radius;
+            let camera_still = |a: f32, b: f32| facing_at(a).angle_to(facing_at(b)).abs() < still_rad;
             if let Some(p) = last.get(&s.serial)
                 && windowed(p)
                 && windowed(&s)
@@ -534,7 +535,7 @@ fn no_creature_flickers_across_the_edge_of_the_view_while_the_camera_holds_still
         }
         count
     };
-    let shipped = default_config().rules.release_margin_deg;
+    let shipped = default_config().rules.release_margin_m;
     assert_eq!(
         flickers(shipped),
         0,
