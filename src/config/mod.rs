@@ -16,8 +16,8 @@ mod validate;
 pub use arena::{ArenaConfig, PuckConfig};
 pub use costs::{CostModel, KindCosts, LevelCosts};
 pub use creature::{
-    BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints, Stance,
-    SteeringConfig,
+    BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints,
+    Stance, SteeringConfig,
 };
 pub use game::{
     CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig, SceneColours, Srgb,

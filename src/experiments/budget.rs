@@ -311,6 +311,15 @@ impl Axis {
         }
     }
 
+    /// The figure of its trade-off on figure 10's count.
+    fn figure(self) -> &'static str {
+        match self {
+            Axis::Mean => "budget.png",
+            Axis::Slowest => "budget-slowest.png",
+            Axis::P99 => "budget-p99.png",
+        }
+    }
+
     /// The key of the budgets set against the fixed radii in the JSON.
     fn key(self) -> &'static str {
         match self {
@@ -344,6 +353,14 @@ impl Measure {
         match self {
             Measure::Count => p.mean_difference,
             Measure::ByObstacle => p.puck_difference.0.abs() + p.wall_difference.0.abs(),
+        }
+    }
+
+    /// Its standard error (by obstacle, the two parts' taken as independent).
+    fn standard_error(self, p: &Point) -> f64 {
+        match self {
+            Measure::Count => p.se_difference,
+            Measure::ByObstacle => p.puck_difference.1.hypot(p.wall_difference.1),
         }
     }
 
@@ -651,13 +668,33 @@ fn finish(
     let (fixed, budget) = (curve("influence"), curve("budget"));
     let against = Axis::ALL.map(|axis| (axis, against_fixed(rows, &fixed, &budget, axis)));
     let (ceilings, targets): (Vec<&Point>, Vec<&Point>) = budget.iter().partition(|p| p.least_benefit_per_ms > 0.0);
+    // One colour per policy in every figure of the experiment.
+    let colour_of = |policy: &str| match policy {
+        "influence" => 0,
+        "budget" => 2,
+        "all-rigid" => 4,
+        _ => 3,
+    };
     let trade_off = |(axis, measure): (Axis, Measure)| {
         let (title, y_label) = axis.panel();
-        let trade = |ps: &[&Point]| ps.iter().map(|p| (measure.of(p), axis.of(p))).collect::<Vec<_>>();
+        // Along the speed-up, so that a curve does not zigzag back on itself.
+        let trade = |ps: &[&Point]| {
+            let mut ps = ps.to_vec();
+            ps.sort_by(|a, b| axis.of(a).total_cmp(&axis.of(b)));
+            Series {
+                x_errors: Some(ps.iter().map(|p| measure.standard_error(p)).collect()),
+                ..Series::new(
+                    "",
+                    ps.iter().map(|p| (measure.of(p), axis.of(p))).collect(),
+                    Mark::Line,
+                    0,
+                )
+            }
+        };
         let notes = fixed
             .iter()
             .chain(&budget)
-            .map(|p| (measure.of(p), axis.of(p), format!("  {}", p.of.label())))
+            .map(|p| (measure.of(p), axis.of(p), p.of.label()))
             .collect();
         let by = if measure == Measure::ByObstacle {
             "by obstacle, "
@@ -665,28 +702,32 @@ fn finish(
             ""
         };
         Panel {
-            title: format!("{by}{title} ({} trials of {} s)", s.trials, s.seconds),
+            title: format!("{by}{title}: {} trials of {} s, bars +- 1 s.e.", s.trials, s.seconds),
             x_label: measure.x_label().into(),
             y_label: y_label.into(),
             series: [
-                ("fixed puck radius (figure 10's rule)", &fixed, 0),
-                ("budget policy, the budget a target", &targets, 1),
+                ("fixed puck radius (figure 10's rule)", &fixed, colour_of("influence")),
+                ("budget policy, the budget a target", &targets, colour_of("budget")),
                 (
                     "budget policy, a ceiling: bought from a least benefit per ms",
                     &ceilings,
-                    2,
+                    colour_of("ceiling"),
                 ),
             ]
             .into_iter()
             .filter(|(_, ps, _)| !ps.is_empty())
-            .map(|(label, ps, colour)| Series::new(label, trade(ps), Mark::Line, colour))
+            .map(|(label, ps, colour)| Series {
+                label: label.into(),
+                colour,
+                ..trade(ps)
+            })
             .collect(),
             notes,
             ..Panel::default()
         }
     };
     let mut trace_series = Vec::new();
-    for (i, c) in crowd.iter().enumerate() {
+    for c in crowd {
         let points = c
             .frame_ms
             .iter()
@@ -697,7 +738,7 @@ fn finish(
             format!("{} (slowest {:.0} ms)", c.policy, c.slowest_frame_ms),
             points,
             Mark::Line,
-            i,
+            colour_of(&c.policy),
         ));
     }
     let frames = crowd.first().map_or(0, |c| c.frames);
@@ -707,21 +748,33 @@ fn finish(
         Mark::Dashed,
         5,
     ));
-    let panels: Vec<Panel> = Axis::ALL
-        .map(|axis| (axis, Measure::Count))
+    // Each figure stands alone, at a size that reads at a page's width.
+    let (width, height) = (1000, 650);
+    let mut figures: Vec<(&str, Panel)> = Axis::ALL
         .into_iter()
-        .chain([(Axis::Mean, Measure::ByObstacle)])
-        .map(trade_off)
-        .chain([Panel {
+        .map(|axis| (axis.figure(), trade_off((axis, Measure::Count))))
+        .collect();
+    figures.push(("budget-by-obstacle.png", trade_off((Axis::Mean, Measure::ByObstacle))));
+    figures.push((
+        "budget-crowd.png",
+        Panel {
             title: format!("frame times of a game of {} creatures", s.crowd_creatures),
             x_label: "simulated time (s)".into(),
             y_label: "wall time of the frame's simulation (ms)".into(),
             log_y: true,
             series: trace_series,
             ..Panel::default()
-        }])
-        .collect();
-    plot::draw(&out.join("budget.png"), 3000, 600, &panels, options.quick)?;
+        },
+    ));
+    for (file, panel) in &figures {
+        plot::draw(
+            &out.join(file),
+            width,
+            height,
+            std::slice::from_ref(panel),
+            options.quick,
+        )?;
+    }
     let mut report = format!(
         "The budget policy (beyond the paper) against figure 10's fixed radii: {} trials of {} s from seeds {} on, each beside the identical \
          trial all rigid; the fixed radii under `{}` with the influence policy, the budgets under `{}` (its weights and cost model). \
@@ -772,6 +825,11 @@ fn finish(
     }
     let _ = write!(
         report,
+        "\nThe trade-off by obstacle, and at the frame rate guaranteed and the frame rate held:\n\n\
+         ![by obstacle](budget-by-obstacle.png)\n\n![slowest frame](budget-slowest.png)\n\n![99th-percentile frame](budget-p99.png)\n"
+    );
+    let _ = write!(
+        report,
         "\nThe crowd: one game of {} creatures (the scenario's mix, the court grown to its density), {} s, seed {}, the budget policy at {} ms; \
          every frame's simulation timed, one process, one policy after the other.\n\n\
          | policy | frames | median frame (ms) | slowest frame (ms) | lowest fps | rigid creatures (mean) |\n|---|---|---|---|---|---|\n",
@@ -784,7 +842,8 @@ fn finish(
             c.policy, c.frames, c.median_frame_ms, c.slowest_frame_ms, c.lowest_fps, c.mean_rigid
         );
     }
-    ExperimentRecord {
+    let _ = write!(report, "\n![the crowd's frames](budget-crowd.png)\n");
+    let record = ExperimentRecord {
         experiment: "budget".into(),
         command: command("budget", options),
         summary: {
@@ -796,8 +855,11 @@ fn finish(
         },
         report,
         smoke_test: options.quick,
-    }
-    .finish(out, &csv)
+    };
+    super::write_out(out, "budget.csv", &csv)?;
+    let mut files = vec!["budget.csv"];
+    files.extend(figures.iter().map(|(file, _)| *file));
+    record.save(out, &files)
 }
 
 /// A table of the budgets against the fixed radii at the same `axis`.

@@ -172,6 +172,53 @@ const X_LABELS_PX: u32 = 45;
 const Y_LABELS_PX: u32 = 70;
 const TITLE_PT: u32 = 20;
 const LEGEND_PT: u32 = 14;
+const NOTE_PT: u32 = 13;
+/// Half the side of the box a marker takes, and the gap between a label and its point.
+const MARKER_PX: i32 = 7;
+const NOTE_GAP_PX: i32 = 5;
+
+/// A rectangle in pixels: left, top, right, bottom.
+type Rect = (i32, i32, i32, i32);
+
+fn overlap(a: Rect, b: Rect) -> bool {
+    a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
+}
+
+/// The top-left corner of each label of `sizes` beside its anchor: of ten places around it
+/// (right, left, above, below, the diagonals, a row further up and down), the first inside `bounds` that covers no
+/// label placed before and no marker; where none is free, the one that covers the fewest.
+fn place_labels(anchors: &[(i32, i32)], sizes: &[(u32, u32)], markers: &[(i32, i32)], bounds: Rect) -> Vec<(i32, i32)> {
+    let marker_boxes: Vec<Rect> = markers
+        .iter()
+        .map(|&(x, y)| (x - MARKER_PX, y - MARKER_PX, x + MARKER_PX, y + MARKER_PX))
+        .collect();
+    let mut placed: Vec<Rect> = Vec::with_capacity(anchors.len());
+    for (&(x, y), &(w, h)) in anchors.iter().zip(sizes) {
+        let (w, h, g) = (w as i32, h as i32, MARKER_PX + NOTE_GAP_PX);
+        // Beside, above, below, then the diagonals; then a row further up and down.
+        let (up, down, up2, down2) = (y - g - h, y + g, y - g - 2 * h - 2, y + g + h + 2);
+        let places = [
+            (x + g, y - h / 2),
+            (x - g - w, y - h / 2),
+            (x - w / 2, up),
+            (x - w / 2, down),
+            (x + g, up),
+            (x + g, down),
+            (x - g - w, up),
+            (x - g - w, down),
+            (x - w / 2, up2),
+            (x - w / 2, down2),
+        ];
+        let covered = |(left, top): (i32, i32)| {
+            let r = (left, top, left + w, top + h);
+            let outside = r.0 < bounds.0 || r.1 < bounds.1 || r.2 > bounds.2 || r.3 > bounds.3;
+            usize::from(outside) * 1000 + placed.iter().chain(&marker_boxes).filter(|&&b| overlap(r, b)).count()
+        };
+        let best = places.into_iter().min_by_key(|&q| covered(q)).expect("ten places");
+        placed.push((best.0, best.1, best.0 + w, best.1 + h));
+    }
+    placed.iter().map(|r| (r.0, r.1)).collect()
+}
 
 /// The legend's share of the plot's width and height: its longest label and its rows measured
 /// in its font, with plotters' marker column and padding around them.
@@ -351,12 +398,28 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                     }))?;
                 }
             }
-            for (x, y, text) in &p.notes {
-                chart.draw_series(std::iter::once(Text::new(
+            // Each label beside its point, where it covers no other label and no marker.
+            let font: TextStyle = ("sans-serif", NOTE_PT).into();
+            let anchors: Vec<(i32, i32)> = p.notes.iter().map(|(x, y, _)| chart.backend_coord(&(*x, *y))).collect();
+            let markers: Vec<(i32, i32)> = p
+                .series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|q| chart.backend_coord(q)))
+                .collect();
+            let sizes: Vec<(u32, u32)> = p
+                .notes
+                .iter()
+                .map(|(_, _, text)| area.estimate_text_size(text, &font))
+                .collect::<Result<_, _>>()?;
+            let (xs, ys) = chart.plotting_area().get_pixel_range();
+            let placed = place_labels(&anchors, &sizes, &markers, (xs.start, ys.start, xs.end, ys.end));
+            let base = area.get_base_pixel();
+            for ((_, _, text), corner) in p.notes.iter().zip(placed) {
+                area.draw(&Text::new(
                     text.clone(),
-                    (*x, *y),
-                    ("sans-serif", 13).into_font(),
-                )))?;
+                    (corner.0 - base.0, corner.1 - base.1),
+                    font.clone(),
+                ))?;
             }
             chart
                 .configure_series_labels()
@@ -431,6 +494,31 @@ mod tests {
         assert_eq!(tidy(2.5), "2.5");
         assert_eq!(tidy(0.0), "0");
         assert_eq!(tidy(-2.7e-17), "0", "a zero tick with a rounding error");
+    }
+
+    #[test]
+    fn labels_beside_crowded_points_cover_no_other_label_and_no_marker() {
+        // Six points in a tight row, with room around: each label finds a free place.
+        let anchors: Vec<(i32, i32)> = (0..6).map(|i| (100 + 25 * i, 200 + 6 * (i % 2))).collect();
+        let sizes = vec![(60, 14); anchors.len()];
+        let bounds = (0, 0, 600, 400);
+        let placed = place_labels(&anchors, &sizes, &anchors, bounds);
+        let rects: Vec<Rect> = placed.iter().map(|&(x, y)| (x, y, x + 60, y + 14)).collect();
+        for (i, r) in rects.iter().enumerate() {
+            assert!(r.0 >= 0 && r.1 >= 0 && r.2 <= 600 && r.3 <= 400, "label {i} inside");
+            for other in &rects[..i] {
+                assert!(!overlap(*r, *other), "label {i} covers another");
+            }
+            for &(x, y) in &anchors {
+                assert!(!overlap(
+                    *r,
+                    (x - MARKER_PX, y - MARKER_PX, x + MARKER_PX, y + MARKER_PX)
+                ));
+            }
+        }
+        // A point at the right edge is labelled on its left.
+        let edge = place_labels(&[(590, 200)], &[(60, 14)], &[], bounds);
+        assert!(edge[0].0 + 60 <= 590);
     }
 
     #[test]

@@ -147,8 +147,6 @@ fn draw_view_cone(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(Startup, spawn_cameras).add_systems(
-        Update,
-        (place_overhead, draw_view_cone).chain().after(ViewSystems),
-    );
+    app.add_systems(Startup, spawn_cameras)
+        .add_systems(Update, (place_overhead, draw_view_cone).chain().after(ViewSystems));
 }

@@ -5,9 +5,9 @@ use bevy::prelude::*;
 use clap::ValueEnum;
 
 use super::GameSettings;
-use super::view::FollowCamera;
 use super::player::{BaseConfig, NewRound, PlayerIntent};
 use super::scene::ColourByLevel;
+use super::view::FollowCamera;
 use crate::config::SimConfig;
 use crate::lod::LevelPolicy;
 

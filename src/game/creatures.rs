@@ -226,7 +226,8 @@ fn apply_poses(
                 .with_scale(Vec3::splat(look.nose_radius_fraction * pose.body_radius_m));
         }
         if let Ok((mut crest, _)) = parts.get_mut(visual.crest) {
-            *crest = Transform::from_translation(crest_at * pose.body_radius_m).with_scale(crest_shape * pose.body_radius_m);
+            *crest =
+                Transform::from_translation(crest_at * pose.body_radius_m).with_scale(crest_shape * pose.body_radius_m);
         }
         if let Ok((mut dot, material)) = parts.get_mut(visual.dot) {
             let ground = to_local.transform_point3(pose.body.translation.with_y(0.05));

@@ -92,7 +92,13 @@ impl SimCamera {
     }
 
     /// A perspective camera at `eye` looking at `aim`, as Bevy's (near plane 0.1 m).
-    pub fn looking_at(eye: Vec3, aim: Vec3, vertical_fov_rad: f32, aspect_ratio: f32, following: Option<Entity>) -> Self {
+    pub fn looking_at(
+        eye: Vec3,
+        aim: Vec3,
+        vertical_fov_rad: f32,
+        aspect_ratio: f32,
+        following: Option<Entity>,
+    ) -> Self {
         let view_from_world = Mat4::look_at_rh(eye, aim, Vec3::Y);
         let clip_from_view = Mat4::perspective_infinite_reverse_rh(vertical_fov_rad, aspect_ratio, 0.1);
         Self::new(clip_from_view * view_from_world, view_from_world.inverse(), following)
@@ -100,7 +106,9 @@ impl SimCamera {
 
     /// Whether any of the sphere at `centre` of `radius` is in view.
     pub fn sees(&self, centre: Vec3, radius: f32) -> bool {
-        self.frustum.iter().all(|h| h.truncate().dot(centre) + h.w + radius >= 0.0)
+        self.frustum
+            .iter()
+            .all(|h| h.truncate().dot(centre) + h.w + radius >= 0.0)
     }
 
     /// Whether any of a creature of this kind at `s` is on screen now.
@@ -249,6 +257,11 @@ impl LevelInputs<'_> {
     }
 }
 
+/// A new world's headless camera starts afresh: it has not turned, nor followed anyone.
+fn forget_camera(mut camera: ResMut<SimCamera>) {
+    *camera = SimCamera::default();
+}
+
 /// Moves the headless camera behind the creature it follows, facing the puck.
 fn place_camera(
     clock: Res<SimClock>,
@@ -275,7 +288,10 @@ fn place_camera(
     let at = |p: Vec2, y: f32| Vec3::new(p.x, y, p.y);
     let placed = SimCamera::looking_at(
         at(state.position - facing * c.follow_distance_m, c.follow_height_m),
-        at(state.position.lerp(puck.position, c.aim_toward_puck_fraction), c.aim_height_m),
+        at(
+            state.position.lerp(puck.position, c.aim_toward_puck_fraction),
+            c.aim_height_m,
+        ),
         c.field_of_view_deg.to_radians(),
         c.aspect_ratio,
         Some(entity),
@@ -390,7 +406,9 @@ pub(super) fn plugin(app: &mut App) {
         .add_systems(
             SimStart,
             (
-                place_camera.run_if(not(resource_exists::<CameraFromView>)),
+                (forget_camera, place_camera)
+                    .chain()
+                    .run_if(not(resource_exists::<CameraFromView>)),
                 start_at_selected_levels,
             )
                 .chain()
@@ -419,7 +437,13 @@ mod tests {
     #[test]
     fn a_creature_in_view_stays_in_view_until_it_is_the_margin_outside_the_frustum() {
         // Eye 1.5 m up looking along +x; 90 degrees wide at aspect 1.
-        let camera = SimCamera::looking_at(Vec3::new(0.0, 1.5, 0.0), Vec3::new(10.0, 1.5, 0.0), 90f32.to_radians(), 1.0, None);
+        let camera = SimCamera::looking_at(
+            Vec3::new(0.0, 1.5, 0.0),
+            Vec3::new(10.0, 1.5, 0.0),
+            90f32.to_radians(),
+            1.0,
+            None,
+        );
         let side = |z: f32| Vec3::new(10.0, 1.5, z);
         // The right edge is at z = 10 m at x = 10 m; the plane's distance is (z - 10) / sqrt 2.
         assert!(camera.sees(side(9.9), 0.0));

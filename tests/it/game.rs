@@ -393,10 +393,7 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
             .single(world)
             .unwrap();
         let kinds = world.resource::<KindTable>().clone();
-        for (c, s, pose, lod) in world
-            .query::<(&Creature, &PlanarState, &GaitPose, &Lod)>()
-            .iter(world)
-        {
+        for (c, s, pose, lod) in world.query::<(&Creature, &PlanarState, &GaitPose, &Lod)>().iter(world) {
             let body = Sphere {
                 center: Vec3::new(s.position.x, pose.body_height_m, s.position.y).into(),
                 radius: kinds.0[c.kind].radius_m,
@@ -416,5 +413,8 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
         }
     }
     // The test sees both sides of the rule.
-    assert!(seen > 1000 && unseen_point_masses > 1000, "{seen} seen, {unseen_point_masses} point masses out of view");
+    assert!(
+        seen > 1000 && unseen_point_masses > 1000,
+        "{seen} seen, {unseen_point_masses} point masses out of view"
+    );
 }

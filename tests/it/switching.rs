@@ -284,8 +284,8 @@ fn the_camera_rule_keeps_creatures_out_of_view_at_the_point_mass_level() {
     let mut config = default_config();
     config.scenario.level_policy = LevelPolicy::Camera;
     let summary = simlod::headless::run(config, 10.0);
-    // A 60 degree cone behind one creature sees a minority of the court.
-    assert!(summary.levels_mean[Lod::PointMass] > 15.0, "{:?}", summary.levels_mean);
+    // A view behind one creature, 60 degrees high on a 16:9 screen, sees part of the court.
+    assert!(summary.levels_mean[Lod::PointMass] > 4.0, "{:?}", summary.levels_mean);
     assert!(
         summary.levels_mean[Lod::Rigid] > 0.0 && summary.levels_mean[Lod::Hybrid] > 0.0,
         "{:?}",
