@@ -188,6 +188,9 @@ enum ExperimentKind {
     /// Beyond the paper: the budget policy against fixed radii on figure 10's axes, and the
     /// frame times of a crowded game.
     Budget(ExperimentRun),
+    /// Beyond the paper: figure 7 taken to crowds, every policy's frame time from a hundred
+    /// creatures to a million.
+    Crowd(ExperimentRun),
     /// Every experiment, into one folder.
     All(ExperimentRun),
     /// Combine fig10 shards (`--shard K/N` runs) into the files of one unsharded run.
@@ -776,6 +779,7 @@ fn main() -> ExitCode {
             ExperimentKind::Fig9(run) => run.run("fig9"),
             ExperimentKind::Fig10(run) => run.run("fig10"),
             ExperimentKind::Budget(run) => run.run("budget"),
+            ExperimentKind::Crowd(run) => run.run("crowd"),
             ExperimentKind::All(run) => run.run("all"),
             ExperimentKind::Merge { dirs, out } => {
                 experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))

@@ -7,6 +7,7 @@
 //! simulation on one thread; they can be split into shards and merged.
 
 pub mod budget;
+pub mod crowd;
 pub mod fig10;
 pub mod fig7;
 pub mod frame_rate;
@@ -132,7 +133,7 @@ pub fn check_kind(config: &SimConfig, file: &Path, field: &str, kind: &str, leve
 fn compared_levels(name: &str) -> &'static [Lod] {
     match name {
         "fig8" | "fig10" | "budget" => &[Lod::Hybrid, Lod::Rigid],
-        "fig9" => &Lod::ALL,
+        "fig9" | "crowd" => &Lod::ALL,
         // table1 measures each kind at the levels it has; fig7 and step-response run one kind
         // from their own file and check it there.
         _ => &[],
@@ -373,7 +374,7 @@ pub fn command(name: &str, options: &Options) -> String {
 }
 
 /// The experiments `simlod experiment all` runs, in the report's order.
-pub const ALL: [&str; 7] = report::ORDER;
+pub const ALL: [&str; 8] = report::ORDER;
 
 /// The experiment file `name` reads unless told otherwise: under the assets folder.
 pub fn default_file(assets: &Path, name: &str) -> PathBuf {
@@ -403,6 +404,7 @@ pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options)
         "fig8" | "fig9" => frame_rate::run(name, config, file, options),
         "fig10" => fig10::run(config, file, options),
         "budget" => budget::run(config, file, options),
+        "crowd" => crowd::run(config, file, options),
         _ => Err(format!("no experiment {name:?}; there are {}", ALL.join(", "))),
     }
 }

@@ -146,7 +146,57 @@ pub const SMOKE_TEST_BANNER: &str = "SMOKE TEST (--quick): checks the pipeline; 
 
 /// Draws `panels` side by side into a PNG of `width` by `height` pixels; a `smoke_test`'s
 /// plot says so in a banner over them.
-pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel], smoke_test: bool) -> Result<(), String> {
+/// Where a panel's parts landed, in the figure's pixels: what a test of its layout reads.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PanelLayout {
+    /// The plotting area inside the axes.
+    pub plot: Rect,
+    /// The legend's box, as the legend's corner and its measured share of the plot give it.
+    pub legend: Rect,
+    /// Each note's box.
+    pub labels: Vec<Rect>,
+    /// Each data point's marker, centre.
+    pub markers: Vec<(i32, i32)>,
+}
+
+impl PanelLayout {
+    /// What is wrong with the layout inside a `width` by `height` figure: a label or the
+    /// legend outside it, a label over another label or a marker, the legend over a marker.
+    pub fn problems(&self, (width, height): (u32, u32)) -> Vec<String> {
+        let figure = (0, 0, width as i32, height as i32);
+        let inside = |r: Rect| r.0 >= figure.0 && r.1 >= figure.1 && r.2 <= figure.2 && r.3 <= figure.3;
+        let marker = |&(x, y): &(i32, i32)| (x - MARKER_PX, y - MARKER_PX, x + MARKER_PX, y + MARKER_PX);
+        let mut problems = Vec::new();
+        if !inside(self.legend) {
+            problems.push(format!("the legend {:?} is outside the figure", self.legend));
+        }
+        if let Some(m) = self.markers.iter().find(|m| overlap(self.legend, marker(m))) {
+            problems.push(format!("the legend covers the marker at {m:?}"));
+        }
+        for (i, &r) in self.labels.iter().enumerate() {
+            if !inside(r) {
+                problems.push(format!("label {i} {r:?} is outside the figure"));
+            }
+            if self.labels[..i].iter().any(|&o| overlap(r, o)) {
+                problems.push(format!("label {i} {r:?} covers another label"));
+            }
+            if let Some(m) = self.markers.iter().find(|m| overlap(r, marker(m))) {
+                problems.push(format!("label {i} {r:?} covers the marker at {m:?}"));
+            }
+        }
+        problems
+    }
+}
+
+/// Draws the panels side by side into a PNG of `width` by `height` pixels, and says where
+/// their parts landed.
+pub fn draw(
+    path: &Path,
+    width: u32,
+    height: u32,
+    panels: &[Panel],
+    smoke_test: bool,
+) -> Result<Vec<PanelLayout>, String> {
     register();
     let fail = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
@@ -157,10 +207,18 @@ pub fn draw(path: &Path, width: u32, height: u32, panels: &[Panel], smoke_test: 
     } else {
         root.clone()
     };
-    for (area, panel) in area.split_evenly((1, panels.len().max(1))).iter().zip(panels) {
-        draw_panel(area, panel).map_err(|e| fail(&e))?;
+    let layouts: Vec<PanelLayout> = area
+        .split_evenly((1, panels.len().max(1)))
+        .iter()
+        .zip(panels)
+        .map(|(area, panel)| draw_panel(area, panel).map_err(|e| fail(&e)))
+        .collect::<Result<_, _>>()?;
+    root.present().map_err(|e| fail(&e))?;
+    // A figure still worth having is kept, and what would mislead a reader is said.
+    for problem in layouts.iter().flat_map(|l: &PanelLayout| l.problems((width, height))) {
+        eprintln!("warning: the layout of {}: {problem}", path.display());
     }
-    root.present().map_err(|e| fail(&e))
+    Ok(layouts)
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
@@ -178,7 +236,7 @@ const MARKER_PX: i32 = 7;
 const NOTE_GAP_PX: i32 = 5;
 
 /// A rectangle in pixels: left, top, right, bottom.
-type Rect = (i32, i32, i32, i32);
+pub type Rect = (i32, i32, i32, i32);
 
 fn overlap(a: Rect, b: Rect) -> bool {
     a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3
@@ -186,11 +244,18 @@ fn overlap(a: Rect, b: Rect) -> bool {
 
 /// The top-left corner of each label of `sizes` beside its anchor: of ten places around it
 /// (right, left, above, below, the diagonals, a row further up and down), the first inside `bounds` that covers no
-/// label placed before and no marker; where none is free, the one that covers the fewest.
-fn place_labels(anchors: &[(i32, i32)], sizes: &[(u32, u32)], markers: &[(i32, i32)], bounds: Rect) -> Vec<(i32, i32)> {
+/// label placed before, no marker and no error bar; where none is free, the one that covers the fewest.
+fn place_labels(
+    anchors: &[(i32, i32)],
+    sizes: &[(u32, u32)],
+    markers: &[(i32, i32)],
+    bars: &[Rect],
+    bounds: Rect,
+) -> Vec<(i32, i32)> {
     let marker_boxes: Vec<Rect> = markers
         .iter()
         .map(|&(x, y)| (x - MARKER_PX, y - MARKER_PX, x + MARKER_PX, y + MARKER_PX))
+        .chain(bars.iter().copied())
         .collect();
     let mut placed: Vec<Rect> = Vec::with_capacity(anchors.len());
     for (&(x, y), &(w, h)) in anchors.iter().zip(sizes) {
@@ -310,7 +375,8 @@ fn room_for_legend((y0, y1): (f64, f64), h: f64, log: bool) -> f64 {
     }
 }
 
-fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> {
+fn draw_panel(area: &Area, p: &Panel) -> Result<PanelLayout, Box<dyn std::error::Error>> {
+    let mut layout = PanelLayout::default();
     let xs = p.series.iter().flat_map(Series::reach).map(|q| q.0);
     let (mut x0, mut x1) = range(xs, false);
     if !p.x_names.is_empty() {
@@ -321,9 +387,15 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
         ((x0, x1), (y0, y1)) = to_scale((x0, x1), (y0, y1), plot_size(area));
     }
     let share = legend_share(area, p);
-    let (mut legend, hidden) = legend_corner(p, share, (x0, x1), (y0, y1));
+    // A marker half under the legend is hidden too: its reach counts.
+    let (plot_w, plot_h) = plot_size(area);
+    let guarded = (
+        share.0 + f64::from(MARKER_PX) / f64::from(plot_w),
+        share.1 + f64::from(MARKER_PX) / f64::from(plot_h),
+    );
+    let (mut legend, hidden) = legend_corner(p, guarded, (x0, x1), (y0, y1));
     if hidden > 0 {
-        y1 = room_for_legend((y0, y1), share.1, p.log_y);
+        y1 = room_for_legend((y0, y1), guarded.1, p.log_y);
         legend = SeriesLabelPosition::UpperRight;
     }
     let mut builder = ChartBuilder::on(area);
@@ -412,15 +484,51 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
                 .map(|(_, _, text)| area.estimate_text_size(text, &font))
                 .collect::<Result<_, _>>()?;
             let (xs, ys) = chart.plotting_area().get_pixel_range();
-            let placed = place_labels(&anchors, &sizes, &markers, (xs.start, ys.start, xs.end, ys.end));
+            let plot = (xs.start, ys.start, xs.end, ys.end);
+            // Error bars, as thin boxes a label should not cross.
+            let bars: Vec<Rect> = p
+                .series
+                .iter()
+                .flat_map(|s| {
+                    s.points.iter().enumerate().flat_map(move |(i, &(x, y))| {
+                        let e = s.errors.as_ref().map_or(0.0, |e| e[i]);
+                        let f = s.x_errors.as_ref().map_or(0.0, |e| e[i]);
+                        [((x, y - e), (x, y + e)), ((x - f, y), (x + f, y))]
+                    })
+                })
+                .map(|(a, b)| {
+                    let (a, b) = (chart.backend_coord(&a), chart.backend_coord(&b));
+                    (a.0.min(b.0) - 2, a.1.min(b.1) - 2, a.0.max(b.0) + 2, a.1.max(b.1) + 2)
+                })
+                .collect();
+            let placed = place_labels(&anchors, &sizes, &markers, &bars, plot);
             let base = area.get_base_pixel();
-            for ((_, _, text), corner) in p.notes.iter().zip(placed) {
+            for (((_, _, text), corner), &(w, h)) in p.notes.iter().zip(&placed).zip(&sizes) {
                 area.draw(&Text::new(
                     text.clone(),
                     (corner.0 - base.0, corner.1 - base.1),
                     font.clone(),
                 ))?;
+                layout
+                    .labels
+                    .push((corner.0, corner.1, corner.0 + w as i32, corner.1 + h as i32));
             }
+            // The legend's box as `legend_corner` reckons it.
+            let (lw, lh) = (
+                (share.0 * f64::from(plot.2 - plot.0)) as i32,
+                (share.1 * f64::from(plot.3 - plot.1)) as i32,
+            );
+            let (right, upper) = match legend {
+                SeriesLabelPosition::UpperLeft => (false, true),
+                SeriesLabelPosition::LowerRight => (true, false),
+                SeriesLabelPosition::LowerLeft => (false, false),
+                _ => (true, true),
+            };
+            let left = if right { plot.2 - lw } else { plot.0 };
+            let top = if upper { plot.1 } else { plot.3 - lh };
+            layout.legend = (left, top, left + lw, top + lh);
+            layout.plot = plot;
+            layout.markers = markers;
             chart
                 .configure_series_labels()
                 .background_style(WHITE.mix(0.85))
@@ -436,7 +544,7 @@ fn draw_panel(area: &Area, p: &Panel) -> Result<(), Box<dyn std::error::Error>> 
     } else {
         body!(builder.build_cartesian_2d(x0..x1, y0..y1)?);
     }
-    Ok(())
+    Ok(layout)
 }
 
 #[cfg(test)]
@@ -502,7 +610,7 @@ mod tests {
         let anchors: Vec<(i32, i32)> = (0..6).map(|i| (100 + 25 * i, 200 + 6 * (i % 2))).collect();
         let sizes = vec![(60, 14); anchors.len()];
         let bounds = (0, 0, 600, 400);
-        let placed = place_labels(&anchors, &sizes, &anchors, bounds);
+        let placed = place_labels(&anchors, &sizes, &anchors, &[], bounds);
         let rects: Vec<Rect> = placed.iter().map(|&(x, y)| (x, y, x + 60, y + 14)).collect();
         for (i, r) in rects.iter().enumerate() {
             assert!(r.0 >= 0 && r.1 >= 0 && r.2 <= 600 && r.3 <= 400, "label {i} inside");
@@ -516,9 +624,42 @@ mod tests {
                 ));
             }
         }
+        // A horizontal error bar through a point sends its label above or below it.
+        let bar = (40, 198, 160, 202);
+        let over_bar = place_labels(&[(100, 200)], &[(60, 14)], &[(100, 200)], &[bar], bounds);
+        assert!(!overlap(
+            (over_bar[0].0, over_bar[0].1, over_bar[0].0 + 60, over_bar[0].1 + 14),
+            bar
+        ));
         // A point at the right edge is labelled on its left.
-        let edge = place_labels(&[(590, 200)], &[(60, 14)], &[], bounds);
+        let edge = place_labels(&[(590, 200)], &[(60, 14)], &[], &[], bounds);
         assert!(edge[0].0 + 60 <= 590);
+    }
+
+    #[test]
+    fn a_layout_with_a_label_on_a_marker_or_off_the_figure_is_named() {
+        let good = PanelLayout {
+            plot: (50, 50, 550, 350),
+            legend: (400, 50, 550, 120),
+            labels: vec![(112, 190, 170, 204)],
+            markers: vec![(100, 200)],
+        };
+        assert!(good.problems((600, 400)).is_empty(), "{:?}", good.problems((600, 400)));
+        let on_marker = PanelLayout {
+            labels: vec![(95, 195, 150, 209)],
+            ..good.clone()
+        };
+        assert_eq!(on_marker.problems((600, 400)).len(), 1);
+        let outside = PanelLayout {
+            labels: vec![(580, 10, 640, 24)],
+            ..good.clone()
+        };
+        assert_eq!(outside.problems((600, 400)).len(), 1);
+        let legend_on_data = PanelLayout {
+            markers: vec![(100, 200), (500, 80)],
+            ..good
+        };
+        assert_eq!(legend_on_data.problems((600, 400)).len(), 1);
     }
 
     #[test]

@@ -7,7 +7,16 @@ use std::path::{Path, PathBuf};
 use super::{ExperimentRecord, write_out};
 
 /// The experiments in the order the report shows them.
-pub const ORDER: [&str; 7] = ["step-response", "table1", "fig7", "fig8", "fig9", "fig10", "budget"];
+pub const ORDER: [&str; 8] = [
+    "step-response",
+    "table1",
+    "fig7",
+    "fig8",
+    "fig9",
+    "fig10",
+    "budget",
+    "crowd",
+];
 
 /// Rewrites `report.md` in `out` from the experiments whose JSON is there.
 pub fn write(out: &Path) -> Result<PathBuf, String> {

@@ -278,4 +278,5 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
         ],
         false,
     )
+    .map(drop)
 }

@@ -505,3 +505,44 @@ fn a_step_response_longer_than_the_models_keep_time_is_refused_not_shortened() {
     let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
     assert!(err.contains("`duration_s`") && err.contains("10000"), "{err}");
 }
+
+#[test]
+fn every_figure_keeps_its_legend_and_labels_inside_and_off_the_data() {
+    // What `plot::draw` finds in each figure it draws (a label or the legend outside the
+    // figure, over another label or over a data marker) it says on standard error.
+    let out = scratch_dir("experiments_layout");
+    for name in experiments::report::ORDER {
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_simlod"))
+            .args(["experiment", name, "--quick", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(run.status.success(), "{name}: {stderr}");
+        assert!(!stderr.contains("warning: the layout"), "{name}: {stderr}");
+    }
+}
+
+#[test]
+fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
+    let dir = scratch_dir("crowd_stops");
+    let file = dir.join("crowd.ron");
+    // No frame of 3000 rigid creatures takes under a millisecond.
+    let settings =
+        "(policies: [AllRigid, AllPointMass], creatures: [3000, 6000], seconds: 0.2, stop_frame_ms: 1.0, seed: 1)";
+    std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
+    let said = experiments::run_named("crowd", &default_config(), &file, &quick(&dir)).unwrap();
+    every_file_it_says_it_wrote_exists(&said, &dir);
+    let rows = table(&dir.join("crowd.csv"));
+    let rigid: Vec<&Vec<String>> = rows.iter().filter(|r| r[0] == "all-rigid").collect();
+    assert_eq!(rigid.len(), 1, "all rigid stops at its first size: {rows:?}");
+    assert_eq!((rigid[0][1].as_str(), rigid[0][5].as_str()), ("3000", "true"));
+    assert_eq!(rigid[0][2], "1", "the game ends at the frame over the limit");
+    // Every creature is where its policy puts it.
+    let point_masses: Vec<&Vec<String>> = rows.iter().filter(|r| r[0] == "all-point-mass").collect();
+    assert!(!point_masses.is_empty());
+    for r in point_masses {
+        let number = |i: usize| r[i].parse::<f64>().unwrap();
+        assert_eq!(number(6), number(1), "all {} at the point-mass level", r[1]);
+    }
+}

@@ -17,8 +17,8 @@ use clap::ValueEnum;
 use proptest::strategy::Strategy;
 use simlod::config::{ConfigError, SimConfig, load_file};
 use simlod::experiments::{
-    ExperimentFile, budget::BudgetSettings, fig7::Fig7Settings, fig10::Fig10Settings, frame_rate::FrameRateSettings,
-    step_response::StepResponseConfig, table1::Table1Settings,
+    ExperimentFile, budget::BudgetSettings, crowd::CrowdSettings, fig7::Fig7Settings, fig10::Fig10Settings,
+    frame_rate::FrameRateSettings, step_response::StepResponseConfig, table1::Table1Settings,
 };
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
@@ -37,7 +37,7 @@ const SIMULATION_FILES: [&str; 8] = [
 ];
 
 /// The experiments' files, each read by its own settings type.
-const EXPERIMENT_FILES: [&str; 7] = [
+const EXPERIMENT_FILES: [&str; 8] = [
     "experiments/step_response.ron",
     "experiments/table1.ron",
     "experiments/fig7.ron",
@@ -45,6 +45,7 @@ const EXPERIMENT_FILES: [&str; 7] = [
     "experiments/fig9.ron",
     "experiments/fig10.ron",
     "experiments/budget.ron",
+    "experiments/crowd.ron",
 ];
 
 /// Loads an experiment's file as its experiment does.
@@ -57,6 +58,7 @@ fn load_experiment_file(path: &Path) -> Result<(), ConfigError> {
         "fig8" | "fig9" => load_file::<ExperimentFile<FrameRateSettings>>(path).map(drop),
         "fig10" => load_file::<ExperimentFile<Fig10Settings>>(path).map(drop),
         "budget" => load_file::<ExperimentFile<BudgetSettings>>(path).map(drop),
+        "crowd" => load_file::<ExperimentFile<CrowdSettings>>(path).map(drop),
         _ => unreachable!("{name}"),
     }
 }
