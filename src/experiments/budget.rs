@@ -546,6 +546,8 @@ fn summarise(rows: &[Row], settings: &[Setting]) -> Vec<Point> {
 #[derive(Clone, Debug, Serialize)]
 struct Crowd {
     policy: &'static str,
+    #[serde(skip)]
+    level_policy: LevelPolicy,
     frames: usize,
     median_frame_ms: f64,
     slowest_frame_ms: f64,
@@ -575,6 +577,7 @@ fn crowd(config: &SimConfig, rules: &Rules, s: &BudgetSettings) -> Vec<Crowd> {
         eprintln!("budget: the crowd of {} under {name}: done", s.crowd_creatures);
         Crowd {
             policy: name,
+            level_policy: policy,
             frames: frame_ms.len(),
             median_frame_ms: super::median_of(frame_ms.iter().copied()),
             slowest_frame_ms: slowest,
@@ -668,13 +671,6 @@ fn finish(
     let (fixed, budget) = (curve("influence"), curve("budget"));
     let against = Axis::ALL.map(|axis| (axis, against_fixed(rows, &fixed, &budget, axis)));
     let (ceilings, targets): (Vec<&Point>, Vec<&Point>) = budget.iter().partition(|p| p.least_benefit_per_ms > 0.0);
-    // One colour per policy in every figure of the experiment.
-    let colour_of = |policy: &str| match policy {
-        "influence" => 0,
-        "budget" => 2,
-        "all-rigid" => 4,
-        _ => 3,
-    };
     let trade_off = |(axis, measure): (Axis, Measure)| {
         let (title, y_label) = axis.panel();
         // Along the speed-up, so that a curve does not zigzag back on itself.
@@ -706,12 +702,20 @@ fn finish(
             x_label: measure.x_label().into(),
             y_label: y_label.into(),
             series: [
-                ("fixed puck radius (figure 10's rule)", &fixed, colour_of("influence")),
-                ("budget policy, the budget a target", &targets, colour_of("budget")),
+                (
+                    "fixed puck radius (figure 10's rule)",
+                    &fixed,
+                    plot::policy_colour(LevelPolicy::Influence),
+                ),
+                (
+                    "budget policy, the budget a target",
+                    &targets,
+                    plot::policy_colour(LevelPolicy::Budget),
+                ),
                 (
                     "budget policy, a ceiling: bought from a least benefit per ms",
                     &ceilings,
-                    colour_of("ceiling"),
+                    plot::BUDGET_CEILING,
                 ),
             ]
             .into_iter()
@@ -738,7 +742,7 @@ fn finish(
             format!("{} (slowest {:.0} ms)", c.policy, c.slowest_frame_ms),
             points,
             Mark::Line,
-            colour_of(&c.policy),
+            plot::policy_colour(c.level_policy),
         ));
     }
     let frames = crowd.first().map_or(0, |c| c.frames);
@@ -746,7 +750,7 @@ fn finish(
         "1/30 s: 30 fps",
         vec![(0.0, 1e3 / 30.0), (frames as f64 / 30.0, 1e3 / 30.0)],
         Mark::Dashed,
-        5,
+        plot::REFERENCE,
     ));
     // Each figure stands alone, at a size that reads at a page's width.
     let (width, height) = (1000, 650);

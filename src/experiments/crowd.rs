@@ -164,18 +164,19 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             .collect()
     };
     let mut series = Vec::new();
-    for (i, policy) in s.policies.iter().map(|&p| name_of(p)).enumerate() {
+    for &policy in &s.policies {
+        let (name, colour) = (name_of(policy), plot::policy_colour(policy));
         series.push(Series::new(
-            format!("{policy}, mean"),
-            curve(&policy, |g| g.mean_frame_ms),
+            format!("{name}, mean"),
+            curve(&name, |g| g.mean_frame_ms),
             Mark::Line,
-            i,
+            colour,
         ));
         series.push(Series::new(
-            format!("{policy}, slowest"),
-            curve(&policy, |g| g.slowest_frame_ms),
+            format!("{name}, slowest"),
+            curve(&name, |g| g.slowest_frame_ms),
             Mark::Dashed,
-            i,
+            colour,
         ));
     }
     let (lo, hi) = (
@@ -186,7 +187,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         "1/30 s: 30 fps",
         vec![(lo, 1e3 / 30.0), (hi, 1e3 / 30.0)],
         Mark::Dashed,
-        5,
+        plot::REFERENCE,
     ));
     plot::draw(
         &options.out.join("crowd.png"),
@@ -194,7 +195,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         650,
         &[Panel {
             title: format!("frame time against crowd size: games of {} s", s.seconds),
-            x_label: "creatures (log10)".into(),
+            x_label: "creatures, log10 (2 is 100, 6 is 1,000,000)".into(),
             y_label: "wall time of a frame's simulation (ms, log)".into(),
             log_y: true,
             series,
@@ -206,7 +207,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         "Each policy's game at each crowd size: the scenario's mix, the court grown by the square root of the count (the default game's density), \
          seed {}, {} s of simulated time; every frame's simulation timed on this machine's cores, the first (which builds the world) left out. \
          A policy stops at the first size where a frame takes over {} ms.\n\n\
-         | policy | creatures | mean frame (ms) | slowest frame (ms) | 30 fps on average | point mass | hybrid | rigid |\n|---|---|---|---|---|---|---|---|\n",
+         | policy | creatures | mean frame (ms) | slowest frame (ms) | mean within 1/30 s | point mass | hybrid | rigid |\n|---|---|---|---|---|---|---|---|\n",
         s.seed, s.seconds, s.stop_frame_ms
     );
     for g in &games {

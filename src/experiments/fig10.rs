@@ -628,7 +628,7 @@ fn finish(
         "no change",
         difference.iter().map(|&(x, _)| (x, 0.0)).collect(),
         Mark::Dashed,
-        5,
+        plot::REFERENCE,
     );
     let trade: Vec<(f64, f64)> = per_radius.iter().map(|p| (p.mean_difference, p.speedup)).collect();
     let n_trials = per_radius.iter().map(|p| p.trials).max().unwrap_or(0);

@@ -91,14 +91,38 @@ pub struct Panel {
     pub to_scale: bool,
 }
 
-const PALETTE: [RGBColor; 6] = [
+const PALETTE: [RGBColor; 9] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(255, 127, 14),
     RGBColor(148, 103, 189),
     RGBColor(90, 90, 90),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(188, 189, 34),
 ];
+
+/// The palette index of the grey drawn for references (30 fps, the desired speed).
+pub const REFERENCE: usize = 5;
+
+/// One colour per level policy, the same in every figure. A budget used as a ceiling takes
+/// [`BUDGET_CEILING`].
+pub fn policy_colour(policy: crate::lod::LevelPolicy) -> usize {
+    use crate::lod::LevelPolicy::*;
+    match policy {
+        Influence => 0,
+        AllHybrid => 1,
+        Budget => 2,
+        AllRigid => 4,
+        AllPointMass => 6,
+        Camera => 7,
+        Combined => 8,
+    }
+}
+
+/// The budget policy as a ceiling (bought from a least benefit per ms).
+pub const BUDGET_CEILING: usize = 3;
 
 fn register() {
     static ONCE: Once = Once::new();

@@ -215,7 +215,7 @@ fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
             .iter()
             .map(|(t, d, _)| (f64::from(*t), f64::from(d.length())))
             .collect();
-        speed.push(Series::new("desired", desired, Mark::Dashed, 5));
+        speed.push(Series::new("desired", desired, Mark::Dashed, plot::REFERENCE));
     }
     for (i, tr) in traces.iter().enumerate() {
         let points = |f: &dyn Fn(&(f32, Vec2, PlanarState)) -> (f32, f32)| -> Vec<(f64, f64)> {
