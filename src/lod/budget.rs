@@ -21,6 +21,7 @@
 
 use bevy::prelude::*;
 use serde::Serialize;
+use std::cell::Cell;
 
 use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start_at_selected_levels};
 use super::{LevelPolicy, Lod};
@@ -277,6 +278,9 @@ pub fn time_to_contact(d: Vec2, w: Vec2, reach: f32) -> f32 {
     (-b - disc.sqrt()) / (2.0 * a)
 }
 
+/// The first ring of the search for the soonest contact with another creature, m.
+const NEAREST_RING_M: f32 = 4.0;
+
 /// What the benefits are computed from at one decision.
 struct Scene<'a> {
     rules: &'a BudgetRules,
@@ -328,19 +332,33 @@ impl Scene<'_> {
         best = best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)));
         // Other creatures: urgency falls with time, so only the soonest contacts count (one
         // urgency per creature, not one per neighbour).
+        // Nearest first: beyond a ring, a creature is at least `gap` away and closes at most at
+        // the fastest speeds, so once that bound is worth no more than the soonest contact
+        // found, the rest cannot change it (the same value as a search of the whole reach).
         if r.creature_weight > 0.0 {
-            let (mut t_course, mut t_worst) = (f32::INFINITY, f32::INFINITY);
+            let (t_course, t_worst) = (Cell::new(f32::INFINITY), Cell::new(f32::INFINITY));
             let closing = (2.0 * self.top_speed).max(1e-3);
-            self.grid.for_each_within(s.position, self.reach_m, |n| {
-                if n.serial == c.serial {
-                    return;
-                }
-                let d = s.position - n.position;
-                let reach = radius + n.radius + margin;
-                t_worst = t_worst.min((d.length() - reach).max(0.0) / closing);
-                t_course = t_course.min(time_to_contact(d, s.velocity - n.velocity, reach));
-            });
-            best = best.max(r.creature_weight * self.urgency(t_course, t_worst));
+            let (fastest, widest) = self.grid.fastest_and_widest();
+            let closing_on_course = (s.velocity.length() + fastest).max(1e-3);
+            self.grid.for_each_nearest_first(
+                s.position,
+                NEAREST_RING_M,
+                self.reach_m,
+                |n| {
+                    if n.serial == c.serial {
+                        return;
+                    }
+                    let d = s.position - n.position;
+                    let reach = radius + n.radius + margin;
+                    t_worst.set(t_worst.get().min((d.length() - reach).max(0.0) / closing));
+                    t_course.set(t_course.get().min(time_to_contact(d, s.velocity - n.velocity, reach)));
+                },
+                |ring| {
+                    let gap = (ring - (radius + widest + margin)).max(0.0);
+                    self.urgency(gap / closing_on_course, gap / closing) <= self.urgency(t_course.get(), t_worst.get())
+                },
+            );
+            best = best.max(r.creature_weight * self.urgency(t_course.get(), t_worst.get()));
         }
         best
     }
@@ -536,6 +554,7 @@ pub(super) fn plugin(app: &mut App) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::LevelRules;
 
     const COSTS: LevelCosts = LevelCosts {
         point_mass_us_per_frame: 1.0,
@@ -554,6 +573,80 @@ mod tests {
             costs: COSTS,
             benefit: [0.0, 0.5, rigid_benefit],
         }
+    }
+
+    #[test]
+    fn the_nearest_first_search_finds_the_same_soonest_contact_as_the_whole_reach() {
+        let mut rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
+        // The creatures' term alone.
+        (rules.budget.puck_weight, rules.budget.wall_weight) = (0.0, 0.0);
+        let b = &rules.budget;
+        let half = Vec2::splat(60.0);
+        // A crowd at the game's density and some strays far apart, moving up to 3 m/s.
+        let mut seed = 12345u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let creatures: Vec<(Creature, PlanarState)> = (0..3000)
+            .map(|i| {
+                let spread = if i < 2800 { 0.4 } else { 1.0 };
+                let position = (Vec2::new(next(), next()) * 2.0 - Vec2::ONE) * half * spread;
+                let velocity = Vec2::from_angle(next() * std::f32::consts::TAU) * 3.0 * next();
+                (
+                    Creature { kind: 0, serial: i },
+                    PlanarState {
+                        position,
+                        velocity,
+                        ..default()
+                    },
+                )
+            })
+            .collect();
+        let mut grid = NeighbourGrid::new(half, 1.6);
+        grid.rebuild(creatures.iter().map(|(c, s)| crate::sense::Neighbour {
+            position: s.position,
+            velocity: s.velocity,
+            radius: 0.35,
+            mass: 10.0,
+            serial: c.serial,
+        }));
+        let (puck, court, camera) = (
+            PuckState {
+                position: Vec2::splat(1e4),
+                velocity: Vec2::ZERO,
+                radius_m: 1.0,
+            },
+            Court { half_extents: half },
+            SimCamera::default(),
+        );
+        let top_speed = 3.0;
+        let scene = Scene {
+            rules: b,
+            puck: &puck,
+            court: &court,
+            grid: &grid,
+            camera: &camera,
+            top_speed,
+            reach_m: 0.7 + b.contact_margin_m + 2.0 * top_speed * 3.0 * b.contact_horizon_s,
+        };
+        let mut with_neighbours = 0;
+        for (c, s) in &creatures {
+            let (mut t_course, mut t_worst, mut seen) = (f32::INFINITY, f32::INFINITY, 0);
+            grid.for_each_within(s.position, scene.reach_m, |n| {
+                if n.serial != c.serial {
+                    let d = s.position - n.position;
+                    let reach = 0.7 + b.contact_margin_m;
+                    t_worst = t_worst.min((d.length() - reach).max(0.0) / (2.0 * top_speed));
+                    t_course = t_course.min(time_to_contact(d, s.velocity - n.velocity, reach));
+                    seen += 1;
+                }
+            });
+            let whole = b.creature_weight * scene.urgency(t_course, t_worst);
+            assert_eq!(scene.contact(c, s, 0.35), whole, "creature {}", c.serial);
+            with_neighbours += usize::from(seen > 0);
+        }
+        assert!(with_neighbours > 2800);
     }
 
     #[test]

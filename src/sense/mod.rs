@@ -45,6 +45,10 @@ pub struct NeighbourGrid {
     /// Scratch, kept to avoid an allocation per rebuild: each input's block and cell.
     keys: Vec<(u32, u32)>,
     scratch: Vec<Neighbour>,
+    /// The fastest entry's planar speed and the widest footprint: how soon anything beyond a
+    /// distance can come near (a search stops where nothing further can matter).
+    fastest_m_per_s: f32,
+    widest_radius_m: f32,
 }
 
 impl NeighbourGrid {
@@ -80,7 +84,10 @@ impl NeighbourGrid {
         // starts; the scatter moves it on to where b ends, which is where b + 1 starts (no copy
         // of the starts as the scatter's cursors).
         let last = self.block_start.len() - 2;
+        (self.fastest_m_per_s, self.widest_radius_m) = (0.0, 0.0);
         for n in &self.scratch {
+            self.fastest_m_per_s = self.fastest_m_per_s.max(n.velocity.length());
+            self.widest_radius_m = self.widest_radius_m.max(n.radius);
             let (x, y) = self.cell_xy(n.position);
             let b = y * self.block_cols + x / BLOCK_CELLS;
             self.keys.push((b, y * self.cols + x));
@@ -154,6 +161,37 @@ impl NeighbourGrid {
         }
     }
 
+    /// The fastest entry's planar speed, m/s, and the widest entry's footprint radius, m.
+    pub fn fastest_and_widest(&self) -> (f32, f32) {
+        (self.fastest_m_per_s, self.widest_radius_m)
+    }
+
+    /// Calls `f` for every entry within `radius` of `p` in rings of doubling radius from
+    /// `first`, and stops after a ring when `done(ring)` says nothing beyond `ring` can matter.
+    /// An entry is visited once.
+    pub fn for_each_nearest_first(
+        &self,
+        p: Vec2,
+        first: f32,
+        radius: f32,
+        mut f: impl FnMut(&Neighbour),
+        mut done: impl FnMut(f32) -> bool,
+    ) {
+        let (mut inner2, mut ring) = (-1.0f32, first.min(radius));
+        loop {
+            self.for_each_within(p, ring, |n| {
+                if n.position.distance_squared(p) > inner2 {
+                    f(n);
+                }
+            });
+            if ring >= radius || done(ring) {
+                return;
+            }
+            inner2 = ring * ring;
+            ring = (2.0 * ring).min(radius);
+        }
+    }
+
     /// Distance from `p` to the nearest entry's rim, looking no further than `radius`.
     pub fn clearance(&self, p: Vec2, radius: f32) -> f32 {
         let mut best = radius;
@@ -224,6 +262,46 @@ mod tests {
             radius: 0.5,
             ..EMPTY
         }
+    }
+
+    #[test]
+    fn nearest_first_visits_each_entry_once_ring_by_ring_until_told_to_stop() {
+        let mut grid = NeighbourGrid::new(Vec2::new(10.0, 10.0), 1.5);
+        let items: Vec<_> = (0..400)
+            .map(|i| at((i % 20) as f32 - 9.5, (i / 20) as f32 - 9.5, i))
+            .collect();
+        grid.rebuild(items.iter().copied());
+        let within = |r: f32| -> Vec<u32> {
+            let mut want: Vec<u32> = items
+                .iter()
+                .filter(|n| n.position.length() <= r)
+                .map(|n| n.serial)
+                .collect();
+            want.sort();
+            want
+        };
+        let search = |stop_at: f32| {
+            let (mut found, mut rings) = (Vec::new(), Vec::new());
+            grid.for_each_nearest_first(
+                Vec2::ZERO,
+                1.0,
+                9.0,
+                |n| found.push(n.serial),
+                |ring| {
+                    rings.push(ring);
+                    ring >= stop_at
+                },
+            );
+            found.sort();
+            (found, rings)
+        };
+        // Never told to stop: everything within the radius, once; rings 1, 2, 4, 8 (then 9).
+        let (found, rings) = search(f32::INFINITY);
+        assert_eq!(found, within(9.0));
+        assert_eq!(rings, [1.0, 2.0, 4.0, 8.0]);
+        // Told to stop after the ring of 4 m: exactly what lies within it.
+        assert_eq!(search(4.0).0, within(4.0));
+        assert_eq!(grid.fastest_and_widest(), (0.0, 0.5));
     }
 
     #[test]
