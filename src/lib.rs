@@ -158,7 +158,17 @@ impl SimClock {
 
     /// Simulated seconds so far.
     pub fn seconds(&self) -> f64 {
-        self.tick as f64 / f64::from(self.tick_hz)
+        self.seconds_at(self.tick)
+    }
+
+    /// Simulated seconds at the start of `tick`.
+    pub fn seconds_at(&self, tick: u64) -> f64 {
+        tick as f64 / f64::from(self.tick_hz)
+    }
+
+    /// Which tick of its decision's frame this is: 0 at the decision.
+    pub fn tick_in_frame(&self) -> u64 {
+        self.tick % u64::from(self.ticks_per_decision)
     }
 }
 

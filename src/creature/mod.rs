@@ -9,6 +9,7 @@ use std::ops::Index;
 use crate::config::{CreatureDef, LegConfig, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable, LegPose};
 use crate::lod::{DrawnBefore, LevelChoice, Lod};
+use crate::models::point_mass::FrameStep;
 use crate::outcome::CollisionRecord;
 use crate::{SimEntity, SimStart, WorldRng};
 use std::collections::HashMap;
@@ -24,6 +25,7 @@ use std::collections::HashMap;
     DesiredVelocity,
     CollisionRecord,
     DrawnBefore,
+    FrameStep,
     SimEntity
 )]
 pub struct Creature {
@@ -403,6 +405,16 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
             ));
         }
     }
+    // Spawned in bands across the court, each band along x: creatures near in the court are
+    // then near in memory, and every loop that asks a creature's neighbours (steering, contacts,
+    // the spatial index) reads what the creature before it just read. A crowd of a million
+    // spawned in random order spends most of each frame waiting on memory.
+    let band_m = placed.cell_m;
+    batch.sort_by(|a, b| {
+        let key = |s: &PlanarState| ((s.position.y / band_m).floor() as i32, s.position.x);
+        let ((ya, xa), (yb, xb)) = (key(&a.2), key(&b.2));
+        ya.cmp(&yb).then(xa.total_cmp(&xb))
+    });
     // The kinds first: a creature's level builds its model from them as it is spawned.
     commands.insert_resource(kinds);
     commands.insert_resource(serials);

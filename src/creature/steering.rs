@@ -137,7 +137,7 @@ fn steer(
     };
     for (creature, state, mut desired) in creatures.contiguous_iter_mut().expect(DENSE) {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
-        let chunks = creature.chunks(n).zip(state.chunks(n)).zip(desired.chunks_mut(n));
+        let chunks = (creature.chunks(n).zip(state.chunks(n))).zip(desired.bypass_change_detection().chunks_mut(n));
         run_chunks(chunks.map(|((c, s), d)| {
             move || {
                 for ((c, s), d) in c.iter().zip(s).zip(d) {

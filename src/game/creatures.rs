@@ -19,6 +19,7 @@ use crate::config::SimConfig;
 use crate::creature::{Creature, KindTable, PlanarState};
 use crate::gait::GaitPose;
 use crate::lod::{Lod, SwitchBlend, drawn};
+use crate::models::point_mass::FrameStepping;
 
 /// Rapier's bodies face +x; a pose faces -z.
 const RAPIER_TO_POSE: Quat = Quat::from_xyzw(
@@ -289,6 +290,9 @@ fn spawn_player_markers(mut commands: Commands, meshes: Res<PartMeshes>, palette
 }
 
 pub(super) fn plugin(app: &mut App) {
+    // Drawn at the display's frame rate, every creature is read between steering decisions:
+    // none may fall behind its frame.
+    app.insert_resource(FrameStepping { enabled: false });
     let mut assets = app.world_mut().resource_mut::<Assets<Mesh>>();
     let part_meshes = PartMeshes {
         sphere: assets.add(Sphere::new(1.0)),

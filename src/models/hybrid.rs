@@ -7,9 +7,8 @@
 use crate::creature::GaitPhase;
 use crate::gait::{GaitPose, GaitTable};
 
-/// Advances the gait at the table's rhythm for `speed` and poses the body and legs from it.
-pub fn play_gait(gait: &mut GaitPhase, pose: &mut GaitPose, table: &GaitTable, speed: f32, now_s: f32, dt: f32) {
-    let (period, stance) = table.rhythm(speed);
-    gait.advance(period, stance, table.steps_per_stride, now_s, dt);
-    *pose = table.pose(speed, gait.stride(table.steps_per_stride));
+/// The body and legs at `speed` and the gait's place in its stride: a function of the two
+/// alone, so it is worked out only for the ticks something reads it.
+pub fn pose(gait: &GaitPhase, table: &GaitTable, speed: f32) -> GaitPose {
+    table.pose(speed, gait.stride(table.steps_per_stride))
 }

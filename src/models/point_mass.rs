@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use super::hybrid;
 use crate::config::SimConfig;
 use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
-use crate::gait::GaitPose;
+use crate::gait::{GaitPose, GaitTable};
 use crate::lod::{AtPointMass, AtRigid, Lod};
 use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
 
@@ -38,35 +38,44 @@ impl TurnLimit {
 
 /// One tick of the planar point mass: velocity moves toward the desired one, clipped to the
 /// top speed, by at most the acceleration limit. A body faster than its top speed (shoved,
-/// or just switched from the rigid level) slows at the limit: no pop in velocity.
-pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, turn: &TurnLimit, dt: f32) {
+/// or just switched from the rigid level) slows at the limit: no pop in velocity. Returns
+/// whether the body is steady: at the velocity it wants and facing its travel, so that the
+/// next tick at the same desired velocity only moves it on.
+pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, turn: &TurnLimit, dt: f32) -> bool {
     let target = desired.clamp_length_max(kind.top_speed_m_per_s);
     state.velocity += (target - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
     state.position += state.velocity * dt;
     let speed = state.velocity.length();
+    let mut facing = true;
     if speed > HEADING_MIN_SPEED_M_PER_S {
         // Turn toward the direction of travel at the turn rate: no pop when the body came
         // from a level that faced elsewhere.
         let travel = state.velocity / speed;
         state.heading = if state.heading.dot(travel) >= turn.cos {
             travel
-        } else if state.heading.perp_dot(travel).is_sign_negative() {
-            turn.right.rotate(state.heading)
         } else {
-            turn.left.rotate(state.heading)
+            facing = false;
+            if state.heading.perp_dot(travel).is_sign_negative() {
+                turn.right.rotate(state.heading)
+            } else {
+                turn.left.rotate(state.heading)
+            }
         };
     }
+    facing && state.velocity == target
 }
 
-/// Advances the hop cycle by time at the kind's own rhythm.
-pub fn advance_gait(gait: &mut GaitPhase, kind: &KindParams, now_s: f32, dt: f32) {
-    gait.advance(
-        1.0 / kind.cycles_per_s,
-        kind.stance_fraction,
-        kind.steps_per_stride,
-        now_s,
-        dt,
-    );
+/// The hop cycle's rhythm at a level: the step's period and its part on the ground, and the
+/// steps in a stride. A hybrid's comes from its table at its speed; a point mass keeps its
+/// kind's own ("holds the leg at a constant angle", 3.3).
+fn rhythm(kind: &KindParams, table: Option<&GaitTable>, velocity: Vec2) -> (f32, f32, u32) {
+    match table {
+        Some(table) => {
+            let (period, stance) = table.rhythm(velocity.length());
+            (period, stance, table.steps_per_stride)
+        }
+        None => (1.0 / kind.cycles_per_s, kind.stance_fraction, kind.steps_per_stride),
+    }
 }
 
 /// Entering the point-mass level: the legs go to the kind's standing pose (paper 3.3: "holds
@@ -81,7 +90,93 @@ fn enter_point_mass(
     }
 }
 
+/// Whether a planar creature is behind its frame. A creature that nothing reads between two
+/// steering decisions (far from the puck and the walls, not waiting to switch, not steered
+/// by a player: decided with the contacts at each decision) keeps the decision's state while
+/// the frame's ticks go by, and is stepped through all of them at once at the frame's last
+/// tick, or as soon as something needs it sooner. It is the same arithmetic in the same
+/// order, so the same state bit for bit; a crowd's frame was spent moving every creature's
+/// components through memory once a tick, and this moves them once a frame.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameStep {
+    /// Holds the state of its frame's decision tick: the frame's ticks since are still to step.
+    pub behind: bool,
+}
+
+/// Whether planar creatures may fall behind their frame ([`FrameStep`]); absent, they may.
+/// Off where something outside the simulation reads every creature at every tick: the game
+/// draws them at its own frame rate. (Not a resource of the simulation's own: one more
+/// entity in every world would move the rigid level's rounding, see `NearPuckOrWall`.)
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct FrameStepping {
+    /// Whether they may.
+    pub enabled: bool,
+}
+
+/// Steps planar creatures: what a tick of each kind needs, worked out once a tick.
+pub struct PlanarStepper<'a> {
+    kinds: &'a KindTable,
+    turns: Vec<TurnLimit>,
+    clock: SimClock,
+}
+
+impl<'a> PlanarStepper<'a> {
+    /// A stepper for the tick `clock` is at.
+    pub fn new(kinds: &'a KindTable, clock: &SimClock) -> Self {
+        Self {
+            kinds,
+            turns: kinds.0.iter().map(|k| TurnLimit::new(k, clock.dt)).collect(),
+            clock: *clock,
+        }
+    }
+
+    /// Steps one creature through the last `ticks` ticks up to and including this one, at its
+    /// desired velocity: the plane, the gait's rhythm, and (for a hybrid) the pose at the end,
+    /// which depends on the speed and the gait's place alone.
+    pub fn step(
+        &self,
+        creature: &Creature,
+        lod: Lod,
+        desired: Vec2,
+        state: &mut PlanarState,
+        gait: &mut GaitPhase,
+        pose: &mut GaitPose,
+        ticks: u64,
+    ) {
+        let kind = &self.kinds[creature.kind];
+        let (turn, dt) = (&self.turns[creature.kind], self.clock.dt);
+        let table = match (lod, &kind.gait) {
+            (Lod::Hybrid, Some(table)) => Some(table),
+            // A hybrid whose kind has no table is not made: `KindParams::best_level`.
+            (Lod::Hybrid, None) => return,
+            _ => None,
+        };
+        // Once steady, a tick only moves the body on and the gait along at a rhythm that no
+        // longer changes: the same arithmetic as a whole tick, without what comes out the same.
+        let mut steady = None;
+        for tick in self.clock.tick + 1 - ticks..=self.clock.tick {
+            let (period, stance, steps) = match steady {
+                Some(rhythm) => {
+                    state.position += state.velocity * dt;
+                    rhythm
+                }
+                None => {
+                    let now_steady = step_planar(state, desired, kind, turn, dt);
+                    let rhythm = rhythm(kind, table, state.velocity);
+                    steady = now_steady.then_some(rhythm);
+                    rhythm
+                }
+            };
+            gait.advance(period, stance, steps, self.clock.seconds_at(tick) as f32, dt);
+        }
+        if let Some(table) = table {
+            *pose = hybrid::pose(gait, table, state.velocity.length());
+        }
+    }
+}
+
 /// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
+/// A creature behind its frame waits for the frame's last tick.
 fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
@@ -94,42 +189,48 @@ fn step_point_masses(
             &mut PlanarState,
             &mut GaitPhase,
             &mut GaitPose,
+            &mut FrameStep,
         ),
         Without<AtRigid>,
     >,
 ) {
-    let (dt, now) = (clock.dt, clock.seconds() as f32);
-    let turns: Vec<TurnLimit> = kinds.0.iter().map(|k| TurnLimit::new(k, dt)).collect();
+    let stepper = PlanarStepper::new(&kinds, &clock);
+    let in_frame = clock.tick_in_frame();
+    let last_of_frame = in_frame + 1 == u64::from(clock.ticks_per_decision);
     let step = |creature: &Creature,
                 lod: Lod,
                 desired: &DesiredVelocity,
                 state: &mut PlanarState,
                 gait: &mut GaitPhase,
-                pose: &mut GaitPose| {
-        let kind = &kinds[creature.kind];
-        match (lod, &kind.gait) {
-            (Lod::PointMass, _) => {
-                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
-                advance_gait(gait, kind, now, dt);
+                pose: &mut GaitPose,
+                frame: &mut FrameStep| {
+        let ticks = match (frame.behind, last_of_frame) {
+            (false, _) => 1,
+            (true, false) => return,
+            (true, true) => {
+                frame.behind = false;
+                in_frame
             }
-            (Lod::Hybrid, Some(table)) => {
-                step_planar(state, desired.0, kind, &turns[creature.kind], dt);
-                hybrid::play_gait(gait, pose, table, state.velocity.length(), now, dt);
-            }
-            // A hybrid whose kind has no table is not made: `KindParams::best_level`.
-            _ => {}
-        }
+        };
+        stepper.step(creature, lod, desired.0, state, gait, pose, ticks);
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
     // of each creature's components one by one cost more than the step itself.
-    for (creature, lod, desired, mut state, mut gait, mut pose) in creatures.contiguous_iter_mut().expect(DENSE) {
+    for (creature, lod, desired, mut state, mut gait, mut pose, mut frame) in
+        creatures.contiguous_iter_mut().expect(DENSE)
+    {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
+        // Nothing watches these components' change ticks: writing them is a pass of its own.
+        let (state, gait) = (state.bypass_change_detection(), gait.bypass_change_detection());
+        let (pose, frame) = (pose.bypass_change_detection(), frame.bypass_change_detection());
         let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
-            .zip(state.chunks_mut(n).zip(gait.chunks_mut(n)).zip(pose.chunks_mut(n)));
-        run_chunks(chunks.map(|(((c, l), d), ((s, g), p))| {
+            .zip((state.chunks_mut(n).zip(gait.chunks_mut(n))).zip(pose.chunks_mut(n).zip(frame.chunks_mut(n))));
+        run_chunks(chunks.map(|(((c, l), d), ((s, g), (p, f)))| {
             move || {
-                for (((c, l), d), ((s, g), p)) in (c.iter().zip(l).zip(d)).zip(s.iter_mut().zip(g).zip(p)) {
-                    step(c, *l, d, s, g, p);
+                for (((c, l), d), ((s, g), (p, f))) in
+                    (c.iter().zip(l).zip(d)).zip((s.iter_mut().zip(g)).zip(p.iter_mut().zip(f)))
+                {
+                    step(c, *l, d, s, g, p, f);
                 }
             }
         }));
@@ -237,7 +338,8 @@ pub(crate) mod tests {
         let mut flight_ticks = 0;
         let mut touchdowns = Vec::new();
         for i in 0..1100 {
-            advance_gait(&mut g, &k, i as f32 * 0.001, 0.001);
+            let (period, stance, steps) = rhythm(&k, None, Vec2::ZERO);
+            g.advance(period, stance, steps, i as f32 * 0.001, 0.001);
             flight_ticks += g.in_flight as u32;
             if touchdowns.last() != Some(&g.last_touchdown_s) {
                 touchdowns.push(g.last_touchdown_s);

@@ -23,12 +23,15 @@ use std::sync::Mutex;
 use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
 use crate::creature::{
-    Creature, GaitPhase, KindParams, KindTable, PlanarState, SerialCounter, creature_bundle, find_free_spot,
+    Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState, PlayerControlled, SerialCounter,
+    creature_bundle, find_free_spot,
 };
+use crate::gait::GaitPose;
 use crate::lod::{
     AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, LevelSwitched, Lod, PopSummary, PopTally,
-    SwitchTally,
+    SwitchProbe, SwitchTally,
 };
+use crate::models::point_mass::{FrameStep, FrameStepping, PlanarStepper};
 use crate::sense::NeighbourGrid;
 use crate::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
 
@@ -166,7 +169,8 @@ fn collide_point_mass(
 
     if let Some(grid) = grid {
         let mut touching = false;
-        grid.for_each_within(state.position, 2.0 * r + 2.0 * r.max(0.5), |n| {
+        // The neighbours it could touch where it stands: none is wider than the widest.
+        grid.for_each_within(state.position, r + grid.fastest_and_widest().1, |n| {
             let d = state.position - n.position;
             let depth = r + n.radius - d.length();
             if n.serial != creature.serial && depth > 0.0 {
@@ -248,7 +252,26 @@ fn could_reach_puck_or_wall(
         || (state.position.abs() + Vec2::splat(reach + r)).cmpge(half).any()
 }
 
-/// Puck, wall and (at each decision) creature contacts of the planar creatures.
+/// What a planar creature's frame depends on besides its contacts: whether it may fall behind
+/// its frame ([`FrameStep`]), and what catching it up takes.
+type FramePlan<'a> = (
+    &'a Lod,
+    &'a LevelChoice,
+    Has<SwitchProbe>,
+    Has<PlayerControlled>,
+    &'a DesiredVelocity,
+    &'a mut GaitPhase,
+    &'a mut GaitPose,
+    &'a mut FrameStep,
+);
+
+/// Puck, wall and (at each decision) creature contacts of the planar creatures. At each
+/// decision it also says which creatures nothing will read before the next one: none that
+/// could reach the puck or a wall, touches anything, waits to switch, is being measured
+/// after a switch or is steered by a player. Those fall behind their frame ([`FrameStep`]);
+/// checking every creature mid-frame (after a respawn) passes them by, as they cannot touch
+/// the puck or a wall before the next decision, unless the puck went farther than its reach,
+/// when they are caught up first.
 #[allow(clippy::too_many_arguments)]
 fn detect_collisions(
     clock: Res<SimClock>,
@@ -259,10 +282,11 @@ fn detect_collisions(
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
     tally: Res<Tally>,
+    stepping: Option<Res<FrameStepping>>,
     mut switched: MessageReader<LevelSwitched>,
     mut watch: Local<NearPuckOrWall>,
     mut chosen: Local<Parallel<Vec<Entity>>>,
-    mut creatures: Query<(Entity, &Creature, &mut PlanarState, &mut CollisionRecord), Without<AtRigid>>,
+    mut creatures: Query<(Entity, &Creature, &mut PlanarState, &mut CollisionRecord, FramePlan), Without<AtRigid>>,
 ) {
     let collide = |entity, creature: &Creature, state: &mut PlanarState, record: &mut CollisionRecord, grid| {
         let kind = &kinds[creature.kind];
@@ -272,10 +296,10 @@ fn detect_collisions(
         }
     };
     let decision = clock.is_decision_tick();
+    let puck_outran = !decision && puck.position.distance(watch.puck_from) > watch.puck_reach_m;
     if !decision {
         let watch = &mut *watch;
-        watch.check_all |=
-            tally.respawns != watch.respawns || puck.position.distance(watch.puck_from) > watch.puck_reach_m;
+        watch.check_all |= tally.respawns != watch.respawns || puck_outran;
         let down = switched.read().filter(|s| s.from == Lod::Rigid).map(|s| s.creature);
         let before = watch.near.len();
         watch.near.extend(down);
@@ -285,7 +309,7 @@ fn detect_collisions(
         }
         if !watch.check_all {
             for &entity in &watch.near {
-                if let Ok((entity, creature, mut state, mut record)) = creatures.get_mut(entity) {
+                if let Ok((entity, creature, mut state, mut record, _)) = creatures.get_mut(entity) {
                     collide(entity, creature, &mut state, &mut record, None);
                 }
             }
@@ -294,21 +318,69 @@ fn detect_collisions(
     }
     let frame_s = clock.dt * clock.ticks_per_decision as f32;
     let puck_reach_m = config.arena.puck.speed_m_per_s * frame_s;
+    // A frame of one or two ticks has nothing to gain.
+    let may_fall_behind = decision && stepping.is_none_or(|s| s.enabled) && clock.ticks_per_decision > 2;
+    let stepper = PlanarStepper::new(&kinds, &clock);
+    let in_frame = clock.tick_in_frame();
     let chosen_now = &*chosen;
-    let check = |entity: Entity, creature: &Creature, state: &mut PlanarState, record: &mut CollisionRecord| {
+    let check = |entity: Entity,
+                 creature: &Creature,
+                 state: &mut PlanarState,
+                 record: &mut CollisionRecord,
+                 plan: FramePlanItem,
+                 frame: &mut FrameStep| {
+        let (lod, choice, probed, player, desired, gait, pose) = plan;
+        if frame.behind {
+            if !puck_outran {
+                return;
+            }
+            stepper.step(creature, *lod, desired.0, state, gait, pose, in_frame);
+            frame.behind = false;
+        }
         collide(entity, creature, state, record, decision.then_some(&*grid));
+        if !decision {
+            return;
+        }
         let kind = &kinds[creature.kind];
-        if decision && could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s) {
+        let near = could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
+        if near {
             chosen_now.borrow_local_mut().push(entity);
         }
+        frame.behind = may_fall_behind
+            && !near
+            && !record.touching.iter().any(|&t| t)
+            && choice.wanted == *lod
+            && !probed
+            && !player;
     };
-    for (entity, creature, mut state, mut record) in creatures.contiguous_iter_mut().expect(DENSE) {
+    // Nothing watches these components' change ticks: the loops leave them alone (writing
+    // them is a pass over a column of its own).
+    for (
+        entity,
+        creature,
+        mut state,
+        mut record,
+        (lod, choice, probed, player, desired, mut gait, mut pose, mut frame),
+    ) in creatures.contiguous_iter_mut().expect(DENSE)
+    {
         let n = chunk_len(config.scenario.creature_count(), entity.len());
-        let chunks = (entity.chunks(n).zip(creature.chunks(n))).zip(state.chunks_mut(n).zip(record.chunks_mut(n)));
-        run_chunks(chunks.map(|((e, c), (s, r))| {
+        let (state, record) = (state.bypass_change_detection(), record.bypass_change_detection());
+        let (gait, pose, frame) = (
+            gait.bypass_change_detection(),
+            pose.bypass_change_detection(),
+            frame.bypass_change_detection(),
+        );
+        let chunks = ((entity.chunks(n).zip(creature.chunks(n))).zip(state.chunks_mut(n).zip(record.chunks_mut(n))))
+            .zip(
+                (lod.chunks(n).zip(choice.chunks(n)).zip(desired.chunks(n)))
+                    .zip((gait.chunks_mut(n).zip(pose.chunks_mut(n))).zip(frame.chunks_mut(n))),
+            );
+        run_chunks(chunks.map(|(((e, c), (s, r)), (((l, ch), d), ((g, p), f)))| {
             move || {
-                for ((e, c), (s, r)) in (e.iter().zip(c)).zip(s.iter_mut().zip(r)) {
-                    check(*e, c, s, r);
+                let rows = ((e.iter().zip(c)).zip(s.iter_mut().zip(r)))
+                    .zip((l.iter().zip(ch).zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut())));
+                for (((e, c), (s, r)), (((l, ch), d), ((g, p), f))) in rows {
+                    check(*e, c, s, r, (l, ch, probed, player, d, g, p), f);
                 }
             }
         }));
@@ -325,6 +397,17 @@ fn detect_collisions(
         watch.check_all = false;
     }
 }
+
+/// A row of [`FramePlan`] as the loop hands it on (the frame step apart).
+type FramePlanItem<'a> = (
+    &'a Lod,
+    &'a LevelChoice,
+    bool,
+    bool,
+    &'a DesiredVelocity,
+    &'a mut GaitPhase,
+    &'a mut GaitPose,
+);
 
 /// Removes the fallen and starts a new creature of the same kind in a free spot.
 fn respawn_fallen(

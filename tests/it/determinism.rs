@@ -1,7 +1,10 @@
 //! Same seed, same files, same result, bit for bit.
 
 use crate::support::*;
+use bevy::prelude::*;
+use simlod::creature::PlanarState;
 use simlod::lod::Lod;
+use simlod::models::point_mass::{FrameStep, FrameStepping};
 
 #[test]
 fn two_runs_with_one_seed_end_in_identical_states() {
@@ -34,4 +37,98 @@ fn the_rigid_level_is_deterministic_too() {
     let a = digest_after(config.clone(), 5.0);
     assert_eq!(a, digest_after(config, 5.0));
     assert_eq!(a.1.levels[Lod::Rigid], 40);
+}
+
+/// Runs `config` for `seconds` with frame stepping on or off, then `then` on the world at a
+/// decision; its state digest and summary.
+fn stepped(
+    config: &simlod::config::SimConfig,
+    enabled: bool,
+    seconds: f64,
+    then: impl FnOnce(&mut simlod::headless::HeadlessSim),
+) -> (u64, simlod::outcome::Summary) {
+    let mut sim = simlod::headless::HeadlessSim::new(config.clone());
+    sim.app.insert_resource(FrameStepping { enabled });
+    sim.run_for(seconds);
+    then(&mut sim);
+    let mut summary = sim.summary(0.0);
+    summary.realtime_factor = 0.0;
+    (sim.state_digest(), summary)
+}
+
+/// Runs one tick; how many creatures are behind their frame after it.
+fn tick_and_count_behind(sim: &mut simlod::headless::HeadlessSim) -> usize {
+    simlod::headless::run_ticks_per_update(sim.app.world_mut(), 1);
+    sim.app.update();
+    let world = sim.app.world_mut();
+    world.query::<&FrameStep>().iter(world).filter(|f| f.behind).count()
+}
+
+#[test]
+fn creatures_stepped_a_frame_at_a_time_end_where_they_would_a_tick_at_a_time() {
+    use simlod::lod::LevelPolicy::*;
+    for policy in [AllPointMass, AllHybrid, Influence, Combined, Budget] {
+        let config = scene(&[("hopper", 90), ("biped", 30)], policy);
+        // Mid-frame, after 4 s: the creatures behind their frame.
+        let mut behind = 0;
+        let on = stepped(&config, true, 4.0, |sim| behind = tick_and_count_behind(sim));
+        let off = stepped(&config, false, 4.0, |sim| {
+            assert_eq!(
+                tick_and_count_behind(sim),
+                0,
+                "{policy:?}: none falls behind when it is off"
+            );
+        });
+        assert_eq!(on, off, "{policy:?}");
+        assert!(on.1.collisions.iter().any(|(_, n)| n > 0), "{policy:?}: {:?}", on.1);
+        assert!(behind > 30, "{policy:?}: only {behind} of 120 behind their frame");
+    }
+}
+
+#[test]
+fn creatures_behind_their_frame_are_caught_up_when_the_puck_goes_farther_than_it_could() {
+    let config = scene(&[("hopper", 200)], simlod::lod::LevelPolicy::AllPointMass);
+    let half = config.arena.half_extents();
+    // Mid-frame, the puck is put down touching the creature farthest from it (and from the
+    // walls): it and the others behind their frame are stepped to the tick before any is
+    // checked against the puck.
+    let teleport = |sim: &mut simlod::headless::HeadlessSim, was_behind: &mut bool| {
+        tick_and_count_behind(sim);
+        let world = sim.app.world_mut();
+        let puck = *world.resource::<simlod::arena::PuckState>();
+        let (target, behind) = world
+            .query::<(&PlanarState, &FrameStep)>()
+            .iter(world)
+            .filter(|(s, _)| (half - s.position.abs()).min_element() > 3.0)
+            .map(|(s, f)| (s.position, f.behind))
+            .max_by(|a, b| a.0.distance(puck.position).total_cmp(&b.0.distance(puck.position)))
+            .unwrap();
+        *was_behind = behind;
+        let mut puck = world.query_filtered::<&mut Transform, With<simlod::arena::Puck>>();
+        let mut transform = puck.single_mut(world).unwrap();
+        transform.translation.x = target.x + 2.2;
+        transform.translation.z = target.y;
+        let behind_after: Vec<usize> = (0..3).map(|_| tick_and_count_behind(sim)).collect();
+        simlod::headless::run_ticks_per_update(sim.app.world_mut(), 8);
+        behind_after
+    };
+    let mut was_behind = false;
+    let mut behind_after = Vec::new();
+    let on = stepped(&config, true, 2.0, |sim| behind_after = teleport(sim, &mut was_behind));
+    assert!(
+        was_behind,
+        "the creature beside which the puck lands was behind its frame"
+    );
+    // The tick it lands, the puck has not gone anywhere yet in rapier; the tick after, every
+    // creature has been caught up.
+    assert_eq!(behind_after[1], 0, "{behind_after:?}");
+    let off = stepped(&config, false, 2.0, |sim| {
+        teleport(sim, &mut false);
+    });
+    assert_eq!(on, off);
+    assert!(
+        on.1.collisions
+            .iter()
+            .any(|(o, n)| o == simlod::outcome::Obstacle::Puck && n > 0)
+    );
 }
