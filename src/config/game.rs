@@ -156,6 +156,9 @@ pub struct CreatureLook {
     /// A crest on top of the body, in the kind's colour (its file's `look`), tells the kinds
     /// apart: its radius as a share of the body's.
     pub crest_radius_fraction: f32,
+    /// The crest, nose and legs are drawn within this distance of the camera, and the body
+    /// alone beyond it: a crowd's far creatures cost a mesh each. 1 to 100,000 m.
+    pub detail_distance_m: f32,
 }
 
 /// `simlod play --record FILE.gif --frames N`: the animated picture of a round.
@@ -253,6 +256,7 @@ impl Validate for GameConfig {
             v.range("leg_thickness_m", k.leg_thickness_m, 0.001, 1.0);
             v.within("nose_radius_fraction", k.nose_radius_fraction, 0.05, 1.0);
             v.within("crest_radius_fraction", k.crest_radius_fraction, 0.05, 1.0);
+            v.within("detail_distance_m", k.detail_distance_m, 1.0, 100_000.0);
         });
         let r = &self.recording;
         v.nested("recording", |v| {

@@ -7,7 +7,7 @@
 //! gait table at the hybrid one, the standing pose at the point mass). Then [`apply_poses`]
 //! moves the meshes.
 
-use bevy::camera::visibility::RenderLayers;
+use bevy::camera::visibility::{RenderLayers, VisibilityRange};
 use bevy::prelude::*;
 
 use super::GameSettings;
@@ -85,9 +85,15 @@ struct PlayerMarker {
     radii: f32,
 }
 
+/// Where a creature's details (crest, nose, legs) are drawn: near the camera only.
+fn detail_range(settings: &GameSettings) -> VisibilityRange {
+    VisibilityRange::abrupt(0.0, settings.creature_look.detail_distance_m)
+}
+
 fn spawn_visuals(
     mut commands: Commands,
     config: Res<SimConfig>,
+    settings: Res<GameSettings>,
     kinds: Res<KindTable>,
     meshes: Res<PartMeshes>,
     palette: Res<Palette>,
@@ -115,11 +121,16 @@ fn spawn_visuals(
         let body = commands
             .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(palette.body(*lod))))
             .id();
+        let details = detail_range(&settings);
         let nose = commands
-            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(marking.clone())))
+            .spawn((
+                Mesh3d(meshes.sphere.clone()),
+                MeshMaterial3d(marking.clone()),
+                details.clone(),
+            ))
             .id();
         let crest = commands
-            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(marking)))
+            .spawn((Mesh3d(meshes.sphere.clone()), MeshMaterial3d(marking), details.clone()))
             .id();
         let dot = commands
             .spawn((
@@ -131,7 +142,11 @@ fn spawn_visuals(
         let legs: Vec<Entity> = (0..leg_count)
             .map(|_| {
                 commands
-                    .spawn((Mesh3d(meshes.cylinder.clone()), MeshMaterial3d(palette.leg.clone())))
+                    .spawn((
+                        Mesh3d(meshes.cylinder.clone()),
+                        MeshMaterial3d(palette.leg.clone()),
+                        details.clone(),
+                    ))
                     .id()
             })
             .collect();
@@ -153,6 +168,22 @@ fn spawn_visuals(
                 legs,
                 dot,
             });
+    }
+}
+
+/// An edited `game.ron` moves every creature's detail range.
+fn range_details(
+    settings: Res<GameSettings>,
+    visuals: Query<&CreatureVisual>,
+    mut ranges: Query<&mut VisibilityRange>,
+) {
+    let range = detail_range(&settings);
+    for visual in &visuals {
+        for part in [visual.nose, visual.crest].iter().chain(&visual.legs) {
+            if let Ok(mut r) = ranges.get_mut(*part) {
+                *r = range.clone();
+            }
+        }
     }
 }
 
@@ -307,7 +338,13 @@ pub(super) fn plugin(app: &mut App) {
         .add_systems(
             Update,
             (
-                (despawn_orphans, spawn_visuals).chain().before(DrawCreatures::Pose),
+                (
+                    despawn_orphans,
+                    spawn_visuals,
+                    range_details.run_if(resource_changed::<GameSettings>),
+                )
+                    .chain()
+                    .before(DrawCreatures::Pose),
                 pose_creatures.in_set(DrawCreatures::Pose),
                 (apply_poses, mark_player).in_set(DrawCreatures::Apply),
             ),

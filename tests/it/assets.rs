@@ -52,6 +52,30 @@ fn assert_names(err: &ConfigError, file: &str, field: &str, words: &str) {
 }
 
 #[test]
+fn the_crowd_scenario_runs_thousands_of_creatures_at_every_level_inside_its_larger_court() {
+    let root = assets_root();
+    let config = SimConfig::load(&root.join("scenarios/crowd.ron"), &root).unwrap();
+    let default = default_config();
+    assert!(
+        config.scenario.creature_count() >= 2000,
+        "{}",
+        config.scenario.creature_count()
+    );
+    let (half, default_half) = (config.arena.half_extents(), default.arena.half_extents());
+    assert!(half.x * half.y >= 10.0 * default_half.x * default_half.y);
+    let mut sim = simlod::headless::HeadlessSim::new(config.clone());
+    sim.run_for(1.0);
+    let summary = sim.summary(0.0);
+    // The camera rule: detailed where the camera looks, point masses elsewhere.
+    for level in simlod::lod::Lod::ALL {
+        assert!(summary.levels[level] > 0, "{level:?}: {summary:?}");
+    }
+    for (_, state) in creatures(&mut sim) {
+        assert!(state.position.abs().cmple(half).all(), "{state:?}");
+    }
+}
+
+#[test]
 fn shipped_assets_load_and_validate() {
     let config = default_config();
     assert_eq!(config.kinds.len(), 2);
