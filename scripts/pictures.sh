@@ -19,4 +19,6 @@ play --screenshot "$out/screenshot.png" --frames 120
 play --policy all-rigid --screenshot "$out/screenshot-rigid.png" --frames 120
 play --policy camera --screenshot "$out/screenshot-camera.png" --frames 120
 play --policy budget --frame-budget 1 --screenshot "$out/screenshot-budget.png" --frames 120
-ls -l "$out"/round.gif "$out"/screenshot*.png
+# The crowd: 3,000 creatures, a second and a half a frame in software.
+play --scenario scenarios/crowd.ron --screenshot "$out/crowd.png" --frames 40
+ls -l "$out"/round.gif "$out"/screenshot*.png "$out"/crowd.png
