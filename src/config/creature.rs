@@ -104,23 +104,72 @@ pub struct LegConfig {
     pub damping_n_s_per_m: f32,
 }
 
-/// How a kind's legs share the ground (Raibert, Legged Robots That Balance, ch. 4-5).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+/// How a kind's legs share the ground: its legs grouped into virtual legs, which take stance in
+/// turn (Raibert, Chepponis and Brown, "Running on four legs as though they were one", 1986;
+/// Legged Robots That Balance, ch. 6). The legs of a virtual leg touch down and lift off
+/// together, and the one-foot controller runs them as one.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Stance {
-    /// Every leg in stance at once: the one-legged hopper.
+    /// One virtual leg of every leg: the one-legged hopper, or a kangaroo's two legs hopping.
     #[default]
     Together,
-    /// The legs take turns, one stance per step: a biped's run ("one-foot" running).
+    /// Each leg its own virtual leg, in the file's order: a biped's run ("one-foot" running).
     Alternating,
+    /// Virtual legs in the order they take stance, each a list of leg numbers (from 0, in the
+    /// file's order); every leg in exactly one. With legs 0-3 front left, front right, back
+    /// left, back right: trot `[[0, 3], [1, 2]]`, pace `[[0, 2], [1, 3]]`, bound
+    /// `[[0, 1], [2, 3]]`.
+    VirtualLegs(Vec<Vec<usize>>),
 }
 
 impl Stance {
-    /// Steps in one stride of `legs` legs: the gait table records a whole stride.
-    pub fn steps_per_stride(self, legs: usize) -> u32 {
+    /// The virtual legs of a kind with `legs` legs, in the order they take stance.
+    pub fn groups(&self, legs: usize) -> Vec<Vec<usize>> {
         match self {
-            Stance::Together => 1,
-            Stance::Alternating => legs.max(1) as u32,
+            Stance::Together => vec![(0..legs).collect()],
+            Stance::Alternating => (0..legs).map(|i| vec![i]).collect(),
+            Stance::VirtualLegs(groups) => groups.clone(),
         }
+    }
+
+    /// Steps in one stride: one stance of each virtual leg. The gait table records a whole
+    /// stride.
+    pub fn steps_per_stride(&self, legs: usize) -> u32 {
+        self.groups(legs).len().max(1) as u32
+    }
+
+    /// Whether every one of `legs` legs is in exactly one virtual leg.
+    fn check(&self, legs: usize, v: &mut Validator) {
+        let groups = self.groups(legs);
+        let mut seen = vec![0; legs];
+        for group in &groups {
+            for &leg in group {
+                if let Some(n) = seen.get_mut(leg) {
+                    *n += 1;
+                }
+            }
+        }
+        let out_of_range: Vec<usize> = groups.iter().flatten().copied().filter(|&l| l >= legs).collect();
+        v.require(
+            out_of_range.is_empty(),
+            "stance",
+            format!(
+                "the legs are numbered 0 to {}, not {out_of_range:?}",
+                legs.saturating_sub(1)
+            ),
+        );
+        let missing: Vec<usize> = (0..legs).filter(|&l| seen[l] == 0).collect();
+        let twice: Vec<usize> = (0..legs).filter(|&l| seen[l] > 1).collect();
+        v.require(
+            missing.is_empty() && twice.is_empty(),
+            "stance",
+            format!("each leg goes in exactly one virtual leg: legs {missing:?} are in none, legs {twice:?} in more than one"),
+        );
+        v.require(
+            groups.iter().all(|g| !g.is_empty()),
+            "stance",
+            "a virtual leg has at least one leg",
+        );
     }
 }
 
@@ -342,6 +391,7 @@ impl CreatureDef {
                 self.legs.len()
             ),
         );
+        self.stance.check(self.legs.len(), v);
         let body = &self.body;
         for (i, leg) in self.legs.iter().enumerate() {
             let reach = leg.upper_length_m + leg.lower_length_m;

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use rand::RngExt;
 use std::ops::Index;
 
-use crate::config::{CreatureDef, LegConfig, RigidConfig, SimConfig, SteeringConfig};
+use crate::config::{CreatureDef, LegConfig, MAX_LEGS, RigidConfig, SimConfig, SteeringConfig};
 use crate::gait::{GaitPose, GaitTable, LegPose};
 use crate::lod::{DrawnBefore, LevelChoice, Lod};
 use crate::models::point_mass::FrameStep;
@@ -161,8 +161,10 @@ pub struct KindParams {
     pub hips_m: Vec<Vec3>,
     /// Each leg's parts, spring and foot, in the kind's order.
     pub legs: Vec<LegConfig>,
-    /// Steps in a stride: the legs taking turns, or together.
+    /// Steps in a stride: one stance of each virtual leg.
     pub steps_per_stride: u32,
+    /// The legs grouped into virtual legs, in the order they take stance.
+    pub virtual_legs: VirtualLegs,
     /// Hop cycles per second.
     pub cycles_per_s: f32,
     /// Part of the cycle before lift-off.
@@ -213,6 +215,7 @@ impl KindParams {
             hips_m,
             legs: d.legs.clone(),
             steps_per_stride: d.stance.steps_per_stride(d.legs.len()),
+            virtual_legs: VirtualLegs::new(&d.stance.groups(d.legs.len())),
             cycles_per_s: 1.0 / d.hop_period_s,
             stance_fraction: 1.0 - d.flight_fraction,
             fall_impact_speed_m_per_s: d.fall_impact_speed_m_per_s,
@@ -229,6 +232,46 @@ impl KindParams {
                 })
                 .collect(),
         }
+    }
+}
+
+/// A kind's legs grouped into virtual legs (its file's `stance`), kept in fixed arrays: the
+/// controller looks them up each tick without allocating.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct VirtualLegs {
+    /// How many virtual legs: the steps in a stride.
+    pub count: usize,
+    /// Each leg's virtual leg.
+    pub of_leg: [usize; MAX_LEGS],
+    /// Each virtual leg's first leg: its compression ends the virtual leg's, and the legs that
+    /// swing mirror it.
+    pub first_leg: [usize; MAX_LEGS],
+    /// How many legs each virtual leg has.
+    pub legs: [usize; MAX_LEGS],
+}
+
+impl VirtualLegs {
+    /// From a validated grouping: every leg in exactly one group.
+    pub fn new(groups: &[Vec<usize>]) -> Self {
+        let mut v = Self {
+            count: groups.len(),
+            of_leg: [0; MAX_LEGS],
+            first_leg: [0; MAX_LEGS],
+            legs: [0; MAX_LEGS],
+        };
+        for (g, group) in groups.iter().enumerate().take(MAX_LEGS) {
+            v.first_leg[g] = group.first().copied().unwrap_or(0);
+            v.legs[g] = group.len();
+            for &leg in group.iter().filter(|&&l| l < MAX_LEGS) {
+                v.of_leg[leg] = g;
+            }
+        }
+        v
+    }
+
+    /// One virtual leg of every leg: they all hop together.
+    pub fn together(&self) -> bool {
+        self.count == 1
     }
 }
 

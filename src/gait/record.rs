@@ -13,7 +13,7 @@ use bevy::prelude::*;
 use std::fmt::Write as _;
 
 use super::{GaitPose, GaitRow, GaitTable, columns};
-use crate::config::SimConfig;
+use crate::config::{CreatureDef, SimConfig};
 use crate::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use crate::experiments::{EXPERIMENT_COURT_M, lone_creature, stand};
 use crate::headless::HeadlessSim;
@@ -74,36 +74,138 @@ struct Tick {
     position: Vec2,
 }
 
-/// A creature commanded at `speed` along +x, stepped one tick per update.
-fn runner(config: &SimConfig, kind: &str, speed: f32) -> (HeadlessSim, Entity) {
-    let mut config = config.clone();
-    config.scenario.decision_hz = config.scenario.tick_hz;
-    // From near one wall toward the other: the longest straight run the court allows.
-    let start = Vec2::new(10.0 - EXPERIMENT_COURT_M / 2.0, 0.0);
-    let (mut sim, creature) = lone_creature(&config, kind, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
-    let world = sim.app.world_mut();
-    world
-        .entity_mut(creature)
-        .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
-    // Facing its course from the start: the recording is of running, not of turning.
-    stand(world, creature, start, Some(Vec2::X));
-    (sim, creature)
+/// A creature commanded along +x, stepped one tick per update and watched, so that a fall can
+/// be explained.
+struct Runner<'a> {
+    sim: HeadlessSim,
+    creature: Entity,
+    def: &'a CreatureDef,
+    /// The commanded speed.
+    speed: f32,
+    /// The last tick seen, its gait phase and velocity: what the creature did before it fell.
+    seen: Option<(Tick, GaitPhase, Vec2)>,
 }
 
-/// This tick's pose and position, and the gait phase; an error once the creature has fallen
-/// (and was removed).
-fn sample(sim: &mut HeadlessSim, creature: Entity) -> Result<(Tick, GaitPhase), String> {
-    let world = sim.app.world();
-    let fell = || format!("the rigid model fell at {:.2} s", sim.clock().seconds());
-    let pose = *world.get::<GaitPose>(creature).ok_or_else(fell)?;
-    let state = world.get::<PlanarState>(creature).ok_or_else(fell)?;
-    let gait = *world.get::<GaitPhase>(creature).ok_or_else(fell)?;
-    let tick = Tick {
-        t: sim.clock().seconds() as f32,
-        pose,
-        position: state.position,
+impl<'a> Runner<'a> {
+    /// The creature of `def` in `config`, commanded at `speed`.
+    fn new(config: &SimConfig, def: &'a CreatureDef, speed: f32) -> Self {
+        let mut config = config.clone();
+        config.scenario.decision_hz = config.scenario.tick_hz;
+        // From near one wall toward the other: the longest straight run the court allows.
+        let start = Vec2::new(10.0 - EXPERIMENT_COURT_M / 2.0, 0.0);
+        let (mut sim, creature) = lone_creature(&config, &def.name, LevelPolicy::AllRigid, start, EXPERIMENT_COURT_M);
+        let world = sim.app.world_mut();
+        world
+            .entity_mut(creature)
+            .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+        // Facing its course from the start: the recording is of running, not of turning.
+        stand(world, creature, start, Some(Vec2::X));
+        Self {
+            sim,
+            creature,
+            def,
+            speed,
+            seen: None,
+        }
+    }
+
+    /// Commands `speed` from now on.
+    fn command(&mut self, speed: f32) {
+        self.speed = speed;
+        self.sim
+            .app
+            .world_mut()
+            .entity_mut(self.creature)
+            .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+    }
+
+    /// This tick's pose and position, and the gait phase; once the creature has fallen (and
+    /// was removed), an error that says how.
+    fn sample(&mut self) -> Result<(Tick, GaitPhase), String> {
+        let t = self.sim.clock().seconds() as f32;
+        let world = self.sim.app.world();
+        let e = self.creature;
+        let (Some(pose), Some(state), Some(gait)) = (
+            world.get::<GaitPose>(e),
+            world.get::<PlanarState>(e),
+            world.get::<GaitPhase>(e),
+        ) else {
+            return Err(fall_report(self.def, self.speed, t, self.seen));
+        };
+        let tick = Tick {
+            t,
+            pose: *pose,
+            position: state.position,
+        };
+        self.seen = Some((tick, *gait, state.velocity));
+        Ok((tick, *gait))
+    }
+
+    /// One tick on.
+    fn advance(&mut self) -> Result<(Tick, GaitPhase), String> {
+        self.sim.advance_frame();
+        self.sample()
+    }
+
+    /// `seconds` on, watching every tick.
+    fn run_for(&mut self, seconds: f32) -> Result<(), String> {
+        let end = self.sim.clock().seconds() + f64::from(seconds);
+        while self.sim.clock().seconds() < end {
+            self.advance()?;
+        }
+        Ok(())
+    }
+
+    fn seconds(&self) -> f64 {
+        self.sim.clock().seconds()
+    }
+}
+
+/// Why a kind's rigid model fell, and where in its file to look first: the body's height and
+/// tilt against the fall limits, the virtual leg in stance, the speeds, the tick before.
+fn fall_report(def: &CreatureDef, commanded: f32, t: f32, seen: Option<(Tick, GaitPhase, Vec2)>) -> String {
+    let head = format!(
+        "the rigid model of {:?} fell at {t:.2} s, commanded {commanded} m/s",
+        def.name
+    );
+    let (Some((tick, gait, velocity)), Some(r)) = (seen, &def.rigid) else {
+        return format!("{head}, before its first tick");
     };
-    Ok((tick, gait))
+    let pose = &tick.pose;
+    let (roll, pitch) = (pose.roll_rad.to_degrees(), pose.pitch_rad.to_degrees());
+    let tilt = roll.hypot(pitch);
+    let groups = def.stance.groups(def.legs.len());
+    let step = groups.get(usize::from(gait.step)).cloned().unwrap_or_default();
+    let where_in_step = if gait.in_flight {
+        format!("in flight after virtual leg {} (legs {step:?})", gait.step)
+    } else {
+        format!("in stance on virtual leg {} (legs {step:?})", gait.step)
+    };
+    let speed = velocity.length();
+    // Each limit's share used: the nearest to 1 is what tripped.
+    let low = (def.body.hip_height_m - pose.body_height_m) / (def.body.hip_height_m - r.fall.body_min_height_m);
+    let tilted = tilt / r.fall.max_tilt_deg;
+    let look = if speed > 0.5 * r.fall.blow_up_speed_m_per_s || !pose.body_height_m.is_finite() {
+        "The numbers blew up: look first at rigid.joints (Multibody holds the joints exactly), the scenario's \
+         solver_iterations, legs much lighter than the body (legs[].upper_mass_kg, lower_mass_kg)"
+    } else if low >= tilted {
+        "The legs did not hold the body up: look first at legs[].spring_n_per_m (stiffer), \
+         rigid.controller.thrust_initial_m and thrust_max_m, body.mass_kg, legs[].min_length_m"
+    } else if roll.abs() >= pitch.abs() {
+        "It rolled over: look first at rigid.controller.attitude_kp_nm_per_rad and attitude_kd_nm_s_per_rad, the \
+         hips' side spacing (legs[].hip_m.2: a virtual leg's thrust off the centre line rolls the \
+         body), idle_leg_retract_m (a swinging foot that scuffs)"
+    } else {
+        "It pitched over: look first at rigid.controller.attitude_kp_nm_per_rad and attitude_kd_nm_s_per_rad, \
+         foot placement (speed_gain_s, max_foot_offset_fraction), the hips' fore-aft spacing \
+         (legs[].hip_m.0)"
+    };
+    format!(
+        "{head}. At {:.3} s its body was {:.2} m high (it falls below rigid.fall.body_min_height_m, \
+         {} m) and tilted {tilt:.0} degrees (roll {roll:.0}, pitch {pitch:.0}; it falls past \
+         rigid.fall.max_tilt_deg, {}), moving at {speed:.2} m/s, {where_in_step}. {look}.",
+        tick.t, pose.body_height_m, r.fall.body_min_height_m, r.fall.max_tilt_deg
+    )
 }
 
 /// How unsteady a run of strides is: the spread of their periods as a share of the mean, and
@@ -122,19 +224,24 @@ fn unsteadiness(strides: &[(f32, f32)], ticks: &[Tick]) -> (f32, f32) {
 
 /// Records `hops` steady strides at `speed` and averages them into a row: after settling,
 /// the last `hops` strides (each from the first leg's touchdown), once they are steady.
-fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &RecordSettings) -> Result<GaitRow, String> {
-    let (mut sim, creature) = runner(config, kind, speed);
-    sim.run_for(f64::from(s.settle_s));
+fn record_row(
+    config: &SimConfig,
+    def: &CreatureDef,
+    steps: u32,
+    speed: f32,
+    s: &RecordSettings,
+) -> Result<GaitRow, String> {
+    let mut run = Runner::new(config, def, speed);
+    run.run_for(s.settle_s)?;
     let mut ticks: Vec<Tick> = Vec::new();
     let mut stride_starts: Vec<f32> = Vec::new();
     // The stance share of each step, known at the touchdown that ends it.
     let mut stance_shares: Vec<(f32, f32)> = Vec::new();
-    let (_, mut last) = sample(&mut sim, creature)?;
+    let (_, mut last) = run.sample()?;
     // The steadiest run of strides seen, for the error if none is steady enough.
     let mut steadiest = (f32::INFINITY, f32::INFINITY);
     let strides = loop {
-        sim.advance_frame();
-        let (tick, gait) = sample(&mut sim, creature)?;
+        let (tick, gait) = run.advance()?;
         let touched_down = gait.last_touchdown_s != last.last_touchdown_s;
         let stride_starts_now = touched_down && gait.step == 0;
         if touched_down {
@@ -162,7 +269,7 @@ fn record_row(config: &SimConfig, kind: &str, steps: u32, speed: f32, s: &Record
                 break strides;
             }
         }
-        if sim.clock().seconds() > f64::from(s.settle_s + s.steady_within_s) {
+        if run.seconds() > f64::from(s.settle_s + s.steady_within_s) {
             let steadiest = if steadiest.0.is_finite() {
                 format!(
                     "; the steadiest {} had periods {:.1} % apart (at most {:.1} %) and speeds {:.3} m/s apart (at most {})",
@@ -224,21 +331,17 @@ fn pose_at(ticks: &[Tick], t: f32) -> GaitPose {
 
 /// From standing, commanded to `top`: the acceleration of the hop-averaged speed while it
 /// rises from 10 % to 70 % of `top` (the saturated part a limit describes).
-fn measure_acceleration(config: &SimConfig, kind: &str, top: f32) -> Result<f32, String> {
-    let (mut sim, creature) = runner(config, kind, 0.0);
-    sim.run_for(3.0);
-    let start = sim.clock().seconds() as f32;
-    sim.app
-        .world_mut()
-        .entity_mut(creature)
-        .insert(DesiredVelocity(Vec2::new(top, 0.0)));
-    let (_, gait) = sample(&mut sim, creature)?;
+fn measure_acceleration(config: &SimConfig, def: &CreatureDef, top: f32) -> Result<f32, String> {
+    let mut run = Runner::new(config, def, 0.0);
+    run.run_for(3.0)?;
+    let start = run.seconds() as f32;
+    run.command(top);
+    let (_, gait) = run.sample()?;
     let mut last = gait.last_touchdown_s;
     let mut previous: Option<(f32, Vec2)> = None;
     let mut rising_from: Option<(f32, f32)> = None;
-    while sim.clock().seconds() < f64::from(start) + 20.0 {
-        sim.advance_frame();
-        let (tick, gait) = sample(&mut sim, creature)?;
+    while run.seconds() < f64::from(start) + 20.0 {
+        let (tick, gait) = run.advance()?;
         if gait.last_touchdown_s == last {
             continue;
         }
@@ -266,7 +369,7 @@ pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Resu
     let rows = settings
         .speeds_m_per_s
         .iter()
-        .map(|&v| record_row(config, kind, steps, v, settings))
+        .map(|&v| record_row(config, def, steps, v, settings))
         .collect::<Result<Vec<_>, _>>()?;
     let top = rows.iter().map(|r| r.speed_m_per_s).fold(0.0, f32::max);
     Ok(GaitTable {
@@ -274,7 +377,7 @@ pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Resu
         sample_hz: settings.sample_hz,
         steps_per_stride: steps,
         columns: columns(def.legs.len()),
-        acceleration_limit_m_per_s2: measure_acceleration(config, kind, top)?,
+        acceleration_limit_m_per_s2: measure_acceleration(config, def, top)?,
         top_speed_m_per_s: top,
         rows,
     })

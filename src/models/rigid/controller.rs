@@ -1,6 +1,8 @@
 //! Raibert's running controller (Legged Robots That Balance, 1986; paper section 3.1), for any
-//! number of legs, in three decoupled parts that act through the leg in stance (Raibert's
-//! "one-foot" running: a biped's legs take turns, each stance like a hop of the hopper):
+//! number of legs, in three decoupled parts that act through the virtual leg in stance
+//! (Raibert's "one-foot" running: a biped's legs take turns, each stance like a hop of the
+//! hopper; a quadruped's legs that touch down together act as one virtual leg, Raibert,
+//! Chepponis and Brown 1986):
 //! - hop height: the stance leg's spring rest length is raised by a thrust during the second
 //!   half of stance; the thrust is adjusted once a step toward the configured flight time;
 //! - body attitude: in stance, a hip torque between body and stance leg holds the body level,
@@ -9,10 +11,11 @@
 //!   grip);
 //! - speed: in flight the hip swings the leg that lands next so that its foot lands at the
 //!   neutral point, half the distance the body travels in stance, plus a correction
-//!   proportional to the velocity error.
+//!   proportional to the velocity error. Each foot of a virtual leg lands as far from its own
+//!   hip as the virtual foot from the virtual leg's hip.
 //!
-//! With legs in turn, the idle legs are shortened to clear the ground and swung to mirror the
-//! active leg, so that the next one is forward when its turn comes.
+//! With virtual legs in turn, the idle legs are shortened to clear the ground and swung to
+//! mirror the active virtual leg, so that the next one is forward when its turn comes.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
@@ -21,14 +24,14 @@ use std::f32::consts::PI;
 use super::{RigidBodies, RigidPart};
 use crate::SimClock;
 use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
-use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
+use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState, VirtualLegs};
 use crate::gait::GaitPose;
 use crate::lod::AtRigid;
 use crate::outcome::FallQueue;
 
 /// Foot centre this far above its resting height still counts as on the ground.
 pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;
-/// With legs in turn, a stance this many times its expected length has stalled.
+/// With virtual legs in turn, a stance this many times its expected length has stalled.
 const STALLED_STANCE_SHARE: f32 = 3.0;
 /// Share of a leg's twist about its own axis (relative to the body) removed each tick. The
 /// leg is thin, so its twist inertia is tiny: the damping is scaled to it, or it would
@@ -59,7 +62,7 @@ enum Role {
     Stance,
     /// In flight, about to land: foot placement.
     Landing,
-    /// Legs in turn, not this leg's turn: shortened, mirroring the active leg.
+    /// Virtual legs in turn, not this leg's turn: shortened, mirroring the active leg.
     Idle,
 }
 
@@ -68,8 +71,8 @@ enum Role {
 pub struct Raibert {
     /// Flight, compression or thrust.
     pub phase: StancePhase,
-    /// The leg that touched down last: in stance now, or the last one that was.
-    pub stance_leg: usize,
+    /// The virtual leg that touched down last: in stance now, or the last one that was.
+    pub stance_group: usize,
     /// Current thrust (extra spring extension).
     pub thrust_m: f32,
     /// Estimated stance duration, for the neutral point.
@@ -102,7 +105,9 @@ impl Raibert {
             .legs
             .iter()
             .fold(kind.mass_kg, |m, l| m + l.upper_mass_kg + l.lower_mass_kg);
-        let mut stance_s = PI * (total / kind.legs[0].spring_n_per_m).sqrt();
+        let v = &kind.virtual_legs;
+        let stiffness = v.legs[0] as f32 * kind.legs[0].spring_n_per_m;
+        let mut stance_s = PI * (total / stiffness).sqrt();
         let mut hop_period_s = stance_s + r.controller.flight_time_s;
         // In flight from the hybrid level, as the entry pose is: the table's rhythm, so the
         // legs' servos (idle_leg_swap_s) go on where the table's legs were.
@@ -113,7 +118,7 @@ impl Raibert {
         let last_touchdown_s = now - gait.cycle * hop_period_s;
         let mut controller = Self {
             phase: StancePhase::Flight,
-            stance_leg: usize::from(gait.step) % kind.legs.len(),
+            stance_group: usize::from(gait.step) % v.count,
             thrust_m: r.controller.thrust_initial_m,
             stance_s,
             last_touchdown_s,
@@ -124,10 +129,9 @@ impl Raibert {
             entry_s: now,
             entry_lengths_m: [0.0; MAX_LEGS],
         };
-        let together = kind.steps_per_stride == 1;
         for (i, leg) in kind.legs.iter().enumerate() {
-            let role = controller.role(i, kind.legs.len(), together);
-            controller.entry_lengths_m[i] = controller.servo_target(leg, r, role, together, now);
+            let role = controller.role(i, v);
+            controller.entry_lengths_m[i] = controller.servo_target(leg, r, role, v.together(), now);
         }
         controller
     }
@@ -151,23 +155,24 @@ impl Raibert {
             last_touchdown_s: self.last_touchdown_s,
             hop_period_s: self.hop_period_s,
             stance_fraction: (stance / self.hop_period_s).clamp(0.0, 0.999),
-            step: if steps_per_stride > 1 { self.stance_leg as u8 } else { 0 },
+            step: if steps_per_stride > 1 {
+                self.stance_group as u8
+            } else {
+                0
+            },
         }
     }
 
-    /// The leg that lands next: with legs in turn, the one after the last stance leg.
-    fn landing_leg(&self, legs: usize, together: bool) -> usize {
-        if together {
-            self.stance_leg
-        } else {
-            (self.stance_leg + 1) % legs
-        }
+    /// The virtual leg that lands next: the one after the last in stance.
+    fn landing_group(&self, v: &VirtualLegs) -> usize {
+        (self.stance_group + 1) % v.count
     }
 
-    fn role(&self, leg: usize, legs: usize, together: bool) -> Role {
+    fn role(&self, leg: usize, v: &VirtualLegs) -> Role {
+        let group = v.of_leg[leg];
         match self.phase {
-            StancePhase::Flight if together || leg == self.landing_leg(legs, together) => Role::Landing,
-            StancePhase::Compression | StancePhase::Thrust if together || leg == self.stance_leg => Role::Stance,
+            StancePhase::Flight if group == self.landing_group(v) => Role::Landing,
+            StancePhase::Compression | StancePhase::Thrust if group == self.stance_group => Role::Stance,
             _ => Role::Idle,
         }
     }
@@ -269,17 +274,20 @@ fn wrap_angle(a: f32) -> f32 {
 impl Raibert {
     /// Advances the stance/flight state machine on the legs' contacts.
     fn update_phase(&mut self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, now: f32) {
-        let (legs, together) = (kind.legs.len(), kind.steps_per_stride == 1);
+        let (legs, v) = (kind.legs.len(), &kind.virtual_legs);
         let on_ground = |i: usize| s.on_ground(i, &kind.legs[i]);
-        let stance_leg = &s.legs[self.stance_leg];
+        let first = v.first_leg[self.stance_group];
+        let stance_leg = &s.legs[first];
         match self.phase {
             StancePhase::Flight => {
-                // The leg due to land first; any other that meets the ground instead takes over.
-                let landing = self.landing_leg(legs, together);
-                // With legs in turn, not the one that just lifted off (it is retracting).
-                let Some(touched) = (0..legs)
-                    .map(|k| (landing + k) % legs)
-                    .find(|&i| on_ground(i) && (together || i != self.stance_leg))
+                // The virtual leg due to land first; any other that meets the ground instead
+                // takes over. With virtual legs in turn, not the one that just lifted off (it
+                // is retracting).
+                let landing = self.landing_group(v);
+                let Some(touched) = (0..v.count)
+                    .map(|k| (landing + k) % v.count)
+                    .filter(|&g| v.together() || g != self.stance_group)
+                    .find(|&g| (0..legs).any(|i| v.of_leg[i] == g && on_ground(i)))
                 else {
                     return;
                 };
@@ -294,19 +302,19 @@ impl Raibert {
                 self.speed_correction = (self.speed_correction + local_error * c.speed_integral_gain)
                     .clamp_length_max(c.max_speed_correction_m_per_s);
                 self.last_touchdown_s = now;
-                self.stance_leg = touched;
+                self.stance_group = touched;
                 self.phase = StancePhase::Compression;
             }
             StancePhase::Compression
-                if stance_leg.rate >= 0.0 && stance_leg.length < kind.legs[self.stance_leg].rest_length_m =>
+                if stance_leg.rate >= 0.0 && stance_leg.length < kind.legs[first].rest_length_m =>
             {
                 self.phase = StancePhase::Thrust;
             }
             StancePhase::Compression | StancePhase::Thrust
-                if !(0..legs).any(|i| self.role(i, legs, together) == Role::Stance && on_ground(i))
-                    // With legs in turn, a stance that stalled (the leg at its thrust length
-                    // without lifting off) ends: the leg retracts and the next one lands.
-                    || (!together && now - self.last_touchdown_s > STALLED_STANCE_SHARE * self.stance_s) =>
+                if !(0..legs).any(|i| self.role(i, v) == Role::Stance && on_ground(i))
+                    // With virtual legs in turn, a stance that stalled (the leg at its thrust
+                    // length without lifting off) ends: the leg retracts and the next one lands.
+                    || (!v.together() && now - self.last_touchdown_s > STALLED_STANCE_SHARE * self.stance_s) =>
             {
                 self.stance_s = 0.5 * self.stance_s + 0.5 * (now - self.last_touchdown_s).clamp(0.05, 0.5);
                 self.last_liftoff_s = now;
@@ -349,7 +357,7 @@ impl Raibert {
     fn torques(&self, s: &Sensed, kind: &KindParams, r: &RigidConfig, desired: Vec2, clock: (f32, f32)) -> Torques {
         let (now, dt) = clock;
         let c = &r.controller;
-        let (legs, together) = (kind.legs.len(), kind.steps_per_stride == 1);
+        let vl = &kind.virtual_legs;
         let mut out = Torques {
             body: Vec3::ZERO,
             legs: [Vec3::ZERO; MAX_LEGS],
@@ -359,12 +367,19 @@ impl Raibert {
         let along = course(desired, s.body_rotation);
         let command = desired + along * self.speed_correction.x + along.perp() * self.speed_correction.y;
         let placement = v * (self.stance_s / 2.0) + (v - command) * c.speed_gain_s;
-        // The leg the idle ones mirror: the one in stance, or the one about to land.
-        let active = match self.phase {
-            StancePhase::Flight => self.landing_leg(legs, together),
-            _ => self.stance_leg,
+        // The virtual leg the idle ones mirror: the one in stance, or the one about to land.
+        let active_group = match self.phase {
+            StancePhase::Flight => self.landing_group(vl),
+            _ => self.stance_group,
         };
-        let stance_legs = if together { legs as f32 } else { 1.0 };
+        let active = vl.first_leg[active_group];
+        let stance_legs = vl.legs[self.stance_group] as f32;
+        // The landing virtual leg's hip: the mean of its legs' hips.
+        let landing = self.landing_group(vl);
+        let (hips, landing_legs) = (0..kind.legs.len())
+            .filter(|&i| vl.of_leg[i] == landing)
+            .fold((Vec2::ZERO, 0.0), |(sum, n), i| (sum + s.legs[i].hip.xz(), n + 1.0));
+        let virtual_hip = hips / landing_legs;
         let heading = course(Vec2::ZERO, s.body_rotation);
         let mut stance_body = Vec3::ZERO;
         for (i, (sensed, leg)) in s.legs.iter().zip(&kind.legs).enumerate() {
@@ -375,12 +390,13 @@ impl Raibert {
                 let swing_rate = relative_spin - sensed.axis * relative_spin.dot(sensed.axis);
                 sensed.axis.cross(aim) * c.swing_kp_nm_per_rad - swing_rate * c.swing_kd_nm_s_per_rad - twist
             };
-            let tau = match self.role(i, legs, together) {
+            let tau = match self.role(i, vl) {
                 Role::Landing => {
                     let reach = c.max_foot_offset_fraction * sensed.length;
-                    // From the body's centre: a hip off to one side lands its foot under the
-                    // body.
-                    let offset = (placement - sensed.hip.xz()).clamp_length_max(reach);
+                    // The virtual foot lands at the placement from the body's centre (a lone
+                    // hip off to one side lands its foot under the body), and each foot as far
+                    // from its own hip as the virtual foot from the virtual hip.
+                    let offset = (placement - virtual_hip).clamp_length_max(reach);
                     let down = (sensed.length * sensed.length - offset.length_squared()).sqrt();
                     swing_to(Vec3::new(offset.x, -down, offset.y).normalize_or(Vec3::NEG_Y))
                 }
@@ -398,7 +414,7 @@ impl Raibert {
                     let thrust = spring_force(
                         sensed,
                         leg,
-                        self.spring_target((i, leg), r, Role::Stance, together, now),
+                        self.spring_target((i, leg), r, Role::Stance, vl.together(), now),
                     );
                     let moment = sensed.hip.cross(sensed.axis * thrust) * Vec3::new(1.0, 0.0, 1.0);
                     stance_body += twist + moment;
@@ -506,11 +522,11 @@ pub(super) fn control_legs(
                 torque: torques.body,
             };
         }
-        let together = kind.steps_per_stride == 1;
+        let v = &kind.virtual_legs;
         for (i, (leg_bodies, leg)) in bodies.legs.iter().zip(&kind.legs).enumerate() {
-            let role = raibert.role(i, kind.legs.len(), together);
+            let role = raibert.role(i, v);
             let sensed_leg = &sensed.legs[i];
-            let target = raibert.spring_target((i, leg), r, role, together, now);
+            let target = raibert.spring_target((i, leg), r, role, v.together(), now);
             let push = sensed_leg.axis * spring_force(sensed_leg, leg, target);
             for (part, force, torque) in [
                 (leg_bodies.upper, -push, torques.legs[i]),
