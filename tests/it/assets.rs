@@ -253,6 +253,18 @@ fn a_creature_that_cannot_exist_is_refused_naming_the_fields_that_disagree() {
         ),
         ("stance: Together", "stance: Alternating", "stance", "at least 2"),
         (
+            "stance: Together",
+            "stance: VirtualLegs([[0], [0]])",
+            "stance",
+            "exactly one virtual leg",
+        ),
+        (
+            "stance: Together",
+            "stance: VirtualLegs([[0, 1]])",
+            "stance",
+            "numbered 0 to 0",
+        ),
+        (
             "body_min_height_m: 0.4",
             "body_min_height_m: 0.85",
             "rigid.fall.body_min_height_m",

@@ -15,7 +15,7 @@ const SHIPPED: &str = "gaits/hopper.ron";
 /// Records `kind`'s table as `simlod record-gait` does by default and compares it with the
 /// shipped one, byte for byte.
 fn recording_again_reproduces(kind: &str, command: &str) {
-    let mut config = default_config();
+    let mut config = config_having(kind);
     let index = config.kind_index(kind).unwrap();
     config.gaits[index] = None; // as record-gait does: never from an earlier table
     let settings = RecordSettings::up_to(config.kinds[index].top_speed_m_per_s);
@@ -46,6 +46,14 @@ fn recording_the_biped_again_reproduces_its_shipped_table_with_both_legs() {
     let table = config.gaits[config.kind_index("biped").unwrap()].as_ref().unwrap();
     assert_eq!(table.columns, columns(2));
     assert_eq!(table.steps_per_stride, 2, "a stride is a step of each leg");
+}
+
+#[test]
+fn recording_the_kinds_on_virtual_legs_again_reproduces_their_shipped_tables() {
+    for kind in ["kangaroo", "quadruped"] {
+        let command = format!("simlod record-gait --creature assets/creatures/{kind}.ron --speeds 0,1,2");
+        recording_again_reproduces(kind, &command);
+    }
 }
 
 #[test]

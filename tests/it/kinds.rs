@@ -1,13 +1,13 @@
 //! A legged kind is data: kinds that exist only in the tests' own files (a heavier hopper on
-//! longer legs, and a two-legged kind) are built and stepped at every level, by the same code
-//! that runs the shipped kinds.
+//! longer legs, a two-legged kind, a four-legged pacer) are built and stepped at every level, by
+//! the same code that runs the shipped kinds.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use std::path::{Path, PathBuf};
 
 use crate::support::*;
-use simlod::config::{CreatureDef, SimConfig, load_file};
+use simlod::config::{CreatureDef, SimConfig, Stance, load_file};
 use simlod::creature::{Creature, PlanarState};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::gait::{GaitPose, GaitRow, GaitTable, columns};
@@ -63,29 +63,37 @@ fn poses(sim: &mut HeadlessSim) -> Vec<(PlanarState, GaitPose)> {
         .collect()
 }
 
-#[test]
-fn a_kind_from_files_alone_gets_a_gait_table_and_runs_at_every_level() {
-    let assets = fixture_assets("kind_stilt");
-    // Its table is recorded from its own rigid model, as `simlod record-gait` does.
-    let def: CreatureDef = load_file(&assets.join("creatures/stilt.ron")).unwrap();
-    let mut config = scene(&assets, "pinned", 1, LevelPolicy::AllRigid);
+/// The fixtures' scene with the kind of `creatures/<kind>.ron` added, one of it, all rigid.
+fn scene_adding(assets: &Path, kind: &str) -> SimConfig {
+    let def: CreatureDef = load_file(&assets.join(format!("creatures/{kind}.ron"))).unwrap();
+    let mut config = scene(assets, "pinned", 1, LevelPolicy::AllRigid);
     config.kinds.push(def);
     config.gaits.push(None);
-    config.scenario.creatures[0].kind = "stilt".into();
+    config.scenario.creatures[0].kind = kind.into();
+    config
+}
+
+/// Records the table of the fixtures' `kind` into its scratch folder, as `simlod record-gait`
+/// does, then runs four of it at each level: they move, at the hybrid and rigid levels on legs
+/// of lengths within `leg_lengths_m` that all move, and only the rigid level has bodies.
+fn records_its_table_and_runs_at_every_level(kind: &str, leg_lengths_m: std::ops::Range<f32>) {
+    let assets = fixture_assets(&format!("kind_{kind}"));
+    let config = scene_adding(&assets, kind);
+    let legs = config.kinds.last().unwrap().legs.len();
     let settings = RecordSettings {
         speeds_m_per_s: vec![0.0, 1.0, 2.0],
         ..RecordSettings::default()
     };
-    let table = record(&config, "stilt", &settings).expect("the stilt hops steadily");
-    assert_eq!(table.columns, columns(1));
-    std::fs::write(assets.join("gaits/stilt.ron"), to_file_text(&table, "test")).unwrap();
+    let table = record(&config, kind, &settings).unwrap_or_else(|e| panic!("{kind}: {e}"));
+    assert_eq!(table.columns, columns(legs));
+    std::fs::write(assets.join(format!("gaits/{kind}.ron")), to_file_text(&table, "test")).unwrap();
 
     for (policy, level) in [
         (LevelPolicy::AllPointMass, Lod::PointMass),
         (LevelPolicy::AllHybrid, Lod::Hybrid),
         (LevelPolicy::AllRigid, Lod::Rigid),
     ] {
-        let mut sim = HeadlessSim::new(scene(&assets, "stilt", 4, policy));
+        let mut sim = HeadlessSim::new(scene(&assets, kind, 4, policy));
         let before = poses(&mut sim);
         sim.run_for(4.0);
         assert_eq!(levels(&mut sim), vec![level; 4], "{policy:?}");
@@ -95,15 +103,67 @@ fn a_kind_from_files_alone_gets_a_gait_table_and_runs_at_every_level() {
             .zip(&after)
             .filter(|(a, b)| a.0.position.distance(b.0.position) > 0.1)
             .count();
-        assert!(moved >= 2, "{policy:?}: {moved} of 4 stilts moved");
+        assert!(moved >= 2, "{policy:?}: {moved} of 4 {kind}s moved");
         if level != Lod::PointMass {
-            // Its own legs at its own length: the stilt's rest length is 0.85 m (the hopper's 0.75).
-            let legs: Vec<f32> = after.iter().map(|(_, p)| p.legs()[0].length_m).collect();
-            assert!(legs.iter().all(|l| (0.62..0.95).contains(l)), "{policy:?}: {legs:?}");
+            // Its own legs at its own lengths, every one of them moving over a step.
+            sim.run_for(0.1);
+            let later = poses(&mut sim);
+            for leg in 0..legs {
+                let lengths: Vec<f32> = after.iter().map(|(_, p)| p.legs()[leg].length_m).collect();
+                assert!(
+                    lengths.iter().all(|l| leg_lengths_m.contains(l)),
+                    "{policy:?}: leg {leg}: {lengths:?}"
+                );
+                let swung = after
+                    .iter()
+                    .zip(&later)
+                    .any(|(a, b)| a.1.legs()[leg].direction().angle_between(b.1.legs()[leg].direction()) > 0.01);
+                assert!(swung, "{policy:?}: leg {leg} of every {kind} still");
+            }
         }
         let world = sim.app.world_mut();
         let parts = world.query::<&RigidPart>().iter(world).count();
-        assert_eq!(parts, if level == Lod::Rigid { 3 * 4 } else { 0 }, "{policy:?}");
+        assert_eq!(
+            parts,
+            if level == Lod::Rigid { (1 + 2 * legs) * 4 } else { 0 },
+            "{policy:?}"
+        );
+    }
+}
+
+#[test]
+fn a_kind_from_files_alone_gets_a_gait_table_and_runs_at_every_level() {
+    // The stilt's rest length is 0.85 m (the hopper's 0.75).
+    records_its_table_and_runs_at_every_level("stilt", 0.62..0.95);
+}
+
+#[test]
+fn a_four_legged_kind_a_modder_writes_gets_its_table_and_runs_at_every_level() {
+    // Four legs that pace: a grouping of virtual legs no shipped kind uses.
+    records_its_table_and_runs_at_every_level("pacer", 0.55..0.95);
+}
+
+#[test]
+fn a_kind_whose_rigid_model_falls_is_told_what_fell_and_which_numbers_to_look_at() {
+    // The pacer made to bound (front legs, then back legs): its pitch is not held at a run.
+    let assets = fixture_assets("kind_bounder");
+    let mut config = scene_adding(&assets, "pacer");
+    config.kinds.last_mut().unwrap().stance = Stance::VirtualLegs(vec![vec![0, 1], vec![2, 3]]);
+    let settings = RecordSettings {
+        speeds_m_per_s: vec![0.0, 1.0],
+        ..RecordSettings::default()
+    };
+    let err = record(&config, "pacer", &settings).expect_err("the bound falls at 1 m/s");
+    for words in [
+        "\"pacer\" fell at",
+        "commanded 1 m/s",
+        "m high",
+        "tilted",
+        "virtual leg",
+        "look first at",
+        "rigid.",
+    ] {
+        assert!(err.contains(words), "{words:?} not in: {err}");
     }
 }
 

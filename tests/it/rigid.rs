@@ -1,5 +1,6 @@
 //! The rigid-body hopper and biped (paper 3.1): hop or run, track speeds, turn, recover and
-//! fall like dynamic creatures. The biped runs Raibert's "one-foot" gait, its legs in turn.
+//! fall like dynamic creatures. The biped runs Raibert's "one-foot" gait, its legs in turn; the
+//! kangaroo and the quadruped (asset files alone) run it on virtual legs.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
@@ -20,7 +21,7 @@ pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {
 /// One rigid creature of `kind` steered from outside at `desired`, facing it, far from the
 /// walls and the parked puck.
 pub fn lone(kind: &str, desired: Vec2) -> (HeadlessSim, Entity) {
-    lone_in(&default_config(), kind, desired)
+    lone_in(&config_having(kind), kind, desired)
 }
 
 /// As [`lone`], in the world of `config`.
@@ -62,7 +63,7 @@ fn touchdowns(sim: &mut HeadlessSim, entity: Entity, from: f64, seconds: f64) ->
 
 /// A kind's whole mass, from its file.
 fn mass_kg(name: &str) -> f32 {
-    let config = default_config();
+    let config = config_having(name);
     let kind = config.kinds.iter().find(|k| k.name == name).unwrap();
     kind.legs
         .iter()
@@ -111,7 +112,7 @@ fn the_biped_tracks_commanded_speeds_of_zero_to_two_and_a_half_metres_a_second()
 }
 
 fn tracks_speeds(kind: &str, speeds: &[f32]) {
-    tracks_speeds_in(&default_config(), kind, speeds);
+    tracks_speeds_in(&config_having(kind), kind, speeds);
 }
 
 fn tracks_speeds_in(config: &SimConfig, kind: &str, speeds: &[f32]) {
@@ -276,4 +277,62 @@ fn hoppers_and_bipeds_run_all_rigid_with_steering() {
     // Hoppers and bipeds both have a rigid model.
     assert_eq!(summary.levels[Lod::Rigid], 40);
     assert_eq!(summary.creatures, 40);
+}
+
+/// The kinds that run on virtual legs, made of asset files alone: the kangaroo's two legs land
+/// together, the quadruped trots on its diagonal pairs.
+const ON_VIRTUAL_LEGS: [&str; 2] = ["kangaroo", "quadruped"];
+
+#[test]
+fn kinds_on_virtual_legs_track_speeds_of_zero_to_two_metres_a_second() {
+    for kind in ON_VIRTUAL_LEGS {
+        tracks_speeds(kind, &[0.0, 1.0, 2.0]);
+    }
+}
+
+#[test]
+fn kinds_on_virtual_legs_run_in_place_for_sixty_seconds_without_falling() {
+    for kind in ON_VIRTUAL_LEGS {
+        runs_in_place_for_sixty_seconds(kind, 0.5);
+    }
+}
+
+#[test]
+fn kinds_on_virtual_legs_turn_to_a_new_heading_and_hold_it() {
+    for kind in ON_VIRTUAL_LEGS {
+        turns_a_quarter_turn(kind);
+    }
+}
+
+#[test]
+fn kinds_on_virtual_legs_recover_from_a_moderate_push_and_fall_from_a_hard_one() {
+    // The hopper's sudden 0.94 m/s sideways, and its 5.7 m/s; a body and two parts a leg.
+    for kind in ON_VIRTUAL_LEGS {
+        let mass = mass_kg(kind);
+        recovers_from_a_push(kind, 0.94 * mass);
+        let legs = config_having(kind)
+            .kinds
+            .iter()
+            .find(|k| k.name == kind)
+            .unwrap()
+            .legs
+            .len();
+        falls_from_a_push(kind, 5.7 * mass, 1 + 2 * legs);
+    }
+}
+
+#[test]
+fn the_quadruped_paces_on_a_line_of_its_file_and_bounds_in_place() {
+    // Its file's stance line, changed: the legs of one side together (the pace), or the front
+    // legs and then the back legs (the bound; it holds its pitch in place, not yet running).
+    for (stance, speeds) in [
+        (vec![vec![0, 2], vec![1, 3]], &[0.0, 1.0, 2.0][..]),
+        (vec![vec![0, 1], vec![2, 3]], &[0.0][..]),
+    ] {
+        let mut config = config_having("quadruped");
+        let quadruped = config.kind_index("quadruped").unwrap();
+        config.kinds[quadruped].stance = simlod::config::Stance::VirtualLegs(stance);
+        config.gaits[quadruped] = None;
+        tracks_speeds_in(&config, "quadruped", speeds);
+    }
 }

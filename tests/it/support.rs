@@ -14,6 +14,16 @@ pub fn default_config() -> SimConfig {
     SimConfig::load(&root.join("scenarios/default.ron"), &root).expect("the shipped assets load")
 }
 
+/// A scenario that has `kind`: the default one, or the one of every shipped kind.
+pub fn config_having(kind: &str) -> SimConfig {
+    let config = default_config();
+    if config.kind_index(kind).is_some() {
+        return config;
+    }
+    let root = assets_root();
+    SimConfig::load(&root.join("scenarios/all-kinds.ron"), &root).expect("the shipped assets load")
+}
+
 /// The default scenario with `count` hoppers.
 pub fn config_with_hoppers(count: u32) -> SimConfig {
     let mut config = default_config();
