@@ -97,6 +97,21 @@ fn over_whole_games_every_switch_is_drawn_under_the_bars() {
 }
 
 #[test]
+fn kinds_on_virtual_legs_switch_under_the_same_bars() {
+    // The kangaroo's two legs and the quadruped's four, switched by the game's rules.
+    let groups = [("hopper", 10), ("kangaroo", 15), ("quadruped", 15)];
+    let config = scene_in(config_having("quadruped"), &groups, LevelPolicy::Combined);
+    let (_, summary) = digest_after(config, 20.0);
+    let switched = summary.pops.iter().filter(|p| !p.forced).map(|p| p.count).sum::<usize>();
+    assert!(switched >= 20, "{:?}", summary.pops);
+    for p in &summary.pops {
+        let (metres, degrees) = if p.forced { (0.02, 5.0) } else { (0.01, 2.0) };
+        assert!(p.metres.max < metres && p.degrees.max < degrees, "{p:?}");
+        assert!(p.velocity_m_per_s.max < 0.1, "{p:?}");
+    }
+}
+
+#[test]
 fn blending_changes_what_is_drawn_never_the_outcome() {
     let (blended, mut a) = digest_after(game(true), 15.0);
     let (unblended, mut b) = digest_after(game(false), 15.0);

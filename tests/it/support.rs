@@ -58,7 +58,11 @@ pub fn vec2_in_court(p: Vec2, half: Vec2) -> bool {
 /// The shipped kinds and arena in a scene set here: `groups` of (kind, count) under `policy`,
 /// seed 7, so that tests do not move when `default.ron` is retuned.
 pub fn scene(groups: &[(&str, u32)], policy: simlod::lod::LevelPolicy) -> SimConfig {
-    let mut config = default_config();
+    scene_in(default_config(), groups, policy)
+}
+
+/// As [`scene`], from `config`'s files (its kinds, arena and rules).
+pub fn scene_in(mut config: SimConfig, groups: &[(&str, u32)], policy: simlod::lod::LevelPolicy) -> SimConfig {
     config.scenario.seed = 7;
     config.scenario.creatures = groups
         .iter()

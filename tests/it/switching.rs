@@ -325,18 +325,20 @@ fn switching_is_deterministic() {
 
 #[test]
 fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
-    // Hoppers and bipeds, at every level (influence switches between rigid and hybrid, and
-    // the camera rule below takes those out of view to the point mass).
-    let mut config = scene(&[("hopper", 70), ("biped", 30)], LevelPolicy::Combined);
+    // Every shipped kind but the stilt (the hopper's shape again), at every level (influence
+    // switches between rigid and hybrid, and the camera rule below takes those out of view to
+    // the point mass).
+    let groups = [("hopper", 50), ("biped", 20), ("kangaroo", 15), ("quadruped", 15)];
+    let mut config = scene_in(config_having("quadruped"), &groups, LevelPolicy::Combined);
     // Small areas, a thin margin and a short dwell: creatures cross boundaries often.
     config.rules.influence.creature_radius_m = 0.8;
     config.rules.influence.puck_radius_m = 4.0;
     config.rules.min_dwell_s = 0.1;
     config.rules.release_margin_m = 0.3;
-    let (hopper, biped) = (
-        config.kind_index("hopper").unwrap(),
-        config.kind_index("biped").unwrap(),
-    );
+    let kinds: Vec<(usize, usize)> = groups
+        .iter()
+        .map(|&(kind, count)| (config.kind_index(kind).unwrap(), count as usize))
+        .collect();
     let legs: Vec<usize> = config.kinds.iter().map(|k| k.legs.len()).collect();
     let mut sim = HeadlessSim::new(config);
     let mut baseline = None;
@@ -349,7 +351,7 @@ fn a_soak_of_ten_minutes_and_thousands_of_switches_leaks_nothing() {
             .map(|(l, c)| (*l, c.kind))
             .collect();
         assert_eq!(creatures.len(), 100);
-        for (kind, count) in [(hopper, 70), (biped, 30)] {
+        for &(kind, count) in &kinds {
             assert_eq!(
                 creatures.iter().filter(|c| c.1 == kind).count(),
                 count,
