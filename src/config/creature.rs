@@ -160,10 +160,15 @@ impl Stance {
         );
         let missing: Vec<usize> = (0..legs).filter(|&l| seen[l] == 0).collect();
         let twice: Vec<usize> = (0..legs).filter(|&l| seen[l] > 1).collect();
+        let wrong: Vec<String> = [(missing, "in none"), (twice, "in more than one")]
+            .into_iter()
+            .filter(|(legs, _)| !legs.is_empty())
+            .map(|(legs, how)| format!("legs {legs:?} {how}"))
+            .collect();
         v.require(
-            missing.is_empty() && twice.is_empty(),
+            wrong.is_empty(),
             "stance",
-            format!("each leg goes in exactly one virtual leg: legs {missing:?} are in none, legs {twice:?} in more than one"),
+            format!("each leg goes in exactly one virtual leg: {}", wrong.join(", ")),
         );
         v.require(
             groups.iter().all(|g| !g.is_empty()),
