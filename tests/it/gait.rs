@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use crate::support::*;
 use simlod::config::{ConfigError, SimConfig, load_file};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
-use simlod::experiments::lone_creature;
+use simlod::experiments::{lone_creature, stand};
 use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::gait::{GaitPose, GaitTable, columns};
 use simlod::lod::{LevelPolicy, Lod};
@@ -142,16 +142,16 @@ fn an_empty_table_is_refused() {
 /// poses at the same phase of the stride, once settled: the largest gap in each of the table's
 /// columns.
 fn pose_gap(kind: &str, speed: f32) -> Vec<f32> {
-    let config: SimConfig = default_config();
+    let config: SimConfig = config_having(kind);
     let start = Vec2::new(-180.0, 0.0);
     let mut runners: Vec<_> = [LevelPolicy::AllRigid, LevelPolicy::AllHybrid]
         .into_iter()
         .map(|policy| {
             let (mut sim, e) = lone_creature(&config, kind, policy, start, 420.0);
-            sim.app
-                .world_mut()
-                .entity_mut(e)
-                .insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+            let world = sim.app.world_mut();
+            world.entity_mut(e).insert(DesiredVelocity(Vec2::new(speed, 0.0)));
+            // Facing its course: the gap of a steady run, not of a turn.
+            stand(world, e, start, Some(Vec2::X));
             sim.run_for(12.0);
             (sim, e)
         })
@@ -216,6 +216,13 @@ fn at_steady_speeds_the_hybrid_pose_follows_the_rigid_model() {
 fn at_steady_speeds_the_hybrid_biped_follows_the_rigid_biped() {
     // Both legs' columns, at the table's rows and between them, up to near its top speed.
     hybrid_pose_follows_the_rigid_model("biped", &[0.0, 1.5, 2.0, 2.4]);
+}
+
+#[test]
+fn at_steady_speeds_the_hybrid_kinds_on_virtual_legs_follow_their_rigid_models() {
+    // Every leg's columns, at the table's rows and between them, up to near the top speed.
+    hybrid_pose_follows_the_rigid_model("kangaroo", &[0.0, 1.0, 1.5, 1.9]);
+    hybrid_pose_follows_the_rigid_model("quadruped", &[0.0, 1.0, 1.5, 1.75]);
 }
 
 #[test]

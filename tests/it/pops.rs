@@ -102,7 +102,12 @@ fn kinds_on_virtual_legs_switch_under_the_same_bars() {
     let groups = [("hopper", 10), ("kangaroo", 15), ("quadruped", 15)];
     let config = scene_in(config_having("quadruped"), &groups, LevelPolicy::Combined);
     let (_, summary) = digest_after(config, 20.0);
-    let switched = summary.pops.iter().filter(|p| !p.forced).map(|p| p.count).sum::<usize>();
+    let switched = summary
+        .pops
+        .iter()
+        .filter(|p| !p.forced)
+        .map(|p| p.count)
+        .sum::<usize>();
     assert!(switched >= 20, "{:?}", summary.pops);
     for p in &summary.pops {
         let (metres, degrees) = if p.forced { (0.02, 5.0) } else { (0.01, 2.0) };

@@ -336,3 +336,18 @@ fn the_quadruped_paces_on_a_line_of_its_file_and_bounds_in_place() {
         tracks_speeds_in(&config, "quadruped", speeds);
     }
 }
+
+#[test]
+fn kinds_on_virtual_legs_turn_about_and_run_off_without_falling() {
+    // Facing away from a command of 1.5 m/s, as a creature fleeing the puck behind it is.
+    for kind in ON_VIRTUAL_LEGS {
+        let (mut sim, creature) = lone(kind, Vec2::new(1.5, 0.0));
+        let world = sim.app.world_mut();
+        let at = world.get::<PlanarState>(creature).unwrap().position;
+        stand(world, creature, at, Some(Vec2::NEG_X));
+        sim.run_for(15.0);
+        assert_eq!(falls(&mut sim), 0, "{kind}");
+        let s = state(&mut sim, creature).unwrap();
+        assert!(s.velocity.distance(Vec2::new(1.5, 0.0)) < 0.5, "{kind}: {}", s.velocity);
+    }
+}
