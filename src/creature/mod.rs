@@ -66,7 +66,7 @@ impl PlanarState {
 /// Where the creature is in its gait, kept at every level so that a level switch can wait for
 /// the flight window (paper 3.4): read from the controller at the rigid level, advanced by
 /// time at the others. A step runs from one touchdown to the next (a hop of the hopper); a
-/// stride is one step of each leg in turn (one step when the legs share the ground together).
+/// stride is one step of each virtual leg in turn (one step when the legs share the ground together).
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct GaitPhase {
     /// Fraction of the step since the last touchdown, in `[0, 1)`.
@@ -79,7 +79,7 @@ pub struct GaitPhase {
     pub hop_period_s: f32,
     /// Part of the step on the ground, from touchdown.
     pub stance_fraction: f32,
-    /// Which step of the stride this is: the leg that touched down last, with legs in turn.
+    /// Which step of the stride this is: the virtual leg that touched down last.
     pub step: u8,
 }
 
@@ -161,8 +161,6 @@ pub struct KindParams {
     pub hips_m: Vec<Vec3>,
     /// Each leg's parts, spring and foot, in the kind's order.
     pub legs: Vec<LegConfig>,
-    /// Steps in a stride: one stance of each virtual leg.
-    pub steps_per_stride: u32,
     /// The legs grouped into virtual legs, in the order they take stance.
     pub virtual_legs: VirtualLegs,
     /// Hop cycles per second.
@@ -184,6 +182,11 @@ pub struct KindParams {
 }
 
 impl KindParams {
+    /// Steps in a stride: one stance of each virtual leg.
+    pub fn steps_per_stride(&self) -> u32 {
+        self.virtual_legs.count as u32
+    }
+
     /// The most detailed level this kind has a model for, at or below `wanted`.
     pub fn best_level(&self, wanted: Lod) -> Lod {
         self.levels
@@ -214,7 +217,6 @@ impl KindParams {
             standing_pose: GaitPose::new(d.body.hip_height_m, 0.0, 0.0, &standing),
             hips_m,
             legs: d.legs.clone(),
-            steps_per_stride: d.stance.steps_per_stride(d.legs.len()),
             virtual_legs: VirtualLegs::new(&d.stance.groups(d.legs.len())),
             cycles_per_s: 1.0 / d.hop_period_s,
             stance_fraction: 1.0 - d.flight_fraction,
@@ -371,7 +373,11 @@ pub fn starting_gait(level: Lod, params: &KindParams, cycle: f32, now_s: f32) ->
     let (hop_period_s, stance_fraction, pose) = match (level, &params.gait) {
         (Lod::Hybrid, Some(table)) => {
             let (period, stance) = table.rhythm(0.0);
-            (period, stance, table.pose(0.0, cycle / params.steps_per_stride as f32))
+            (
+                period,
+                stance,
+                table.pose(0.0, cycle / params.steps_per_stride() as f32),
+            )
         }
         _ => (1.0 / params.cycles_per_s, params.stance_fraction, params.standing_pose),
     };

@@ -209,7 +209,7 @@ pub struct GaitTable {
     pub creature: String,
     /// 1 to 1000 Hz.
     pub sample_hz: f32,
-    /// Steps in a stride: 1 for legs in stance together, the leg count for legs in turn.
+    /// Steps in a stride: one for each of the kind's virtual legs (1 for legs in stance together).
     pub steps_per_stride: u32,
     /// The names of a sample's values, in order: [`columns`] of the kind's leg count.
     pub columns: Vec<String>,

@@ -74,7 +74,7 @@ fn rhythm(kind: &KindParams, table: Option<&GaitTable>, velocity: Vec2) -> (f32,
             let (period, stance) = table.rhythm(velocity.length());
             (period, stance, table.steps_per_stride)
         }
-        None => (1.0 / kind.cycles_per_s, kind.stance_fraction, kind.steps_per_stride),
+        None => (1.0 / kind.cycles_per_s, kind.stance_fraction, kind.steps_per_stride()),
     }
 }
 
@@ -246,6 +246,7 @@ pub(super) fn plugin(app: &mut App) {
 pub(crate) mod tests {
     use super::*;
     use crate::config::SteeringConfig;
+    use crate::creature::VirtualLegs;
 
     /// A hopper-sized kind: 0.3 m, 10 kg, 3 m/s, 2 m/s^2.
     pub(crate) fn kind() -> KindParams {
@@ -264,7 +265,7 @@ pub(crate) mod tests {
             standing_pose: GaitPose::default(),
             hips_m: vec![Vec3::ZERO],
             legs: Vec::new(),
-            steps_per_stride: 1,
+            virtual_legs: VirtualLegs::new(&[vec![0]]),
             steering: SteeringConfig {
                 cruise_speed_m_per_s: 1.0,
                 wander_turn_rad_per_s: 0.0,

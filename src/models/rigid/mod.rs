@@ -261,8 +261,8 @@ fn entry_pose(
         // In flight, as a switch in the flight window is; the controller starts in flight.
         Some(table) if gait.in_flight => {
             let (period, _) = table.rhythm(speed);
-            let steps = kind.steps_per_stride as f32;
-            let stride = gait.stride(kind.steps_per_stride);
+            let steps = kind.steps_per_stride() as f32;
+            let stride = gait.stride(kind.steps_per_stride());
             let sample = 1.0 / (table.sample_hz * period * steps);
             let (now, next) = (table.pose(speed, stride), table.pose(speed, stride + sample));
             (now, (next.body_height_m - now.body_height_m) * table.sample_hz)
@@ -418,7 +418,7 @@ fn observe_rigid(
         state.position = body.translation.xz();
         state.velocity = body_velocity.linear.xz();
         state.heading = forward.xz().try_normalize().unwrap_or(state.heading);
-        *gait = raibert.gait_phase(now, kind.steps_per_stride);
+        *gait = raibert.gait_phase(now, kind.steps_per_stride());
         if let Some(bodies_pose) = pose_of(bodies, &kind.hips_m, &parts) {
             *pose = bodies_pose;
         }
