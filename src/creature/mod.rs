@@ -497,4 +497,17 @@ mod tests {
         let spot = find_free_spot(&mut rng, half, 10.0, 1.0, |_| 0.0);
         assert_eq!(spot, Vec2::ZERO);
     }
+
+    #[test]
+    fn hop_run_and_trot_are_groupings_of_legs_into_virtual_legs() {
+        use crate::config::Stance;
+        let hop = VirtualLegs::new(&Stance::Together.groups(2));
+        assert!(hop.together());
+        assert_eq!((hop.of_leg, hop.legs[0]), ([0; MAX_LEGS], 2));
+        let run = VirtualLegs::new(&Stance::Alternating.groups(2));
+        assert_eq!((run.count, run.of_leg[1], run.first_leg[1]), (2, 1, 1));
+        let trot = VirtualLegs::new(&Stance::VirtualLegs(vec![vec![0, 3], vec![1, 2]]).groups(4));
+        assert_eq!((trot.count, trot.of_leg, trot.first_leg[1]), (2, [0, 1, 1, 0], 1));
+        assert_eq!(trot.legs[..2], [2, 2]);
+    }
 }
