@@ -78,13 +78,9 @@ pub fn run_chunks<J: FnOnce() + Send>(jobs: impl Iterator<Item = J>) {
 }
 
 pub mod arena;
-pub mod bench;
 pub mod config;
 pub mod creature;
-pub mod experiments;
 pub mod gait;
-#[cfg(feature = "game")]
-pub mod game;
 pub mod headless;
 pub mod lod;
 pub mod models;

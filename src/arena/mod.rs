@@ -48,7 +48,8 @@ fn launch_direction(rng: &mut WorldRng) -> Vec2 {
     Vec2::from_angle(angle)
 }
 
-pub(crate) fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
+/// Builds the court (ground and walls) and the puck at [`SimStart`]: order what dresses them after it.
+pub fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let arena = &config.arena;
     let half = arena.half_extents();
     commands.insert_resource(Court { half_extents: half });

@@ -23,21 +23,7 @@ use serde::{Deserialize, Serialize};
 /// detailed. Inserting a new `Lod` is the switch: its hooks move the creature's level marker
 /// ([`AtPointMass`], [`AtHybrid`], [`AtRigid`]), and each level's observers on its marker
 /// build and tear down what that level is made of. Nothing else knows what a level holds.
-#[derive(
-    Component,
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    Serialize,
-    Deserialize,
-    clap::ValueEnum,
-)]
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[component(on_insert = Lod::mark, on_discard = Lod::unmark)]
 pub enum Lod {
     /// A point mass on the plane with an acceleration limit; the leg held at a constant
@@ -66,6 +52,19 @@ impl Lod {
             Lod::PointMass => "point_mass",
             Lod::Hybrid => "hybrid",
             Lod::Rigid => "rigid",
+        }
+    }
+
+    /// What the level is, in a line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Lod::PointMass => {
+                "A point mass on the plane with an acceleration limit; the leg held at a constant angle (section 3.3)"
+            }
+            Lod::Hybrid => {
+                "The same point mass, with the body and leg posed from the gait table recorded from the rigid model (section 3.2)"
+            }
+            Lod::Rigid => "Rapier rigid bodies and joints driven by Raibert's controller (section 3.1)",
         }
     }
 
@@ -113,7 +112,7 @@ pub struct AtHybrid;
 pub struct AtRigid;
 
 /// How levels are chosen (a scenario's `level_policy`, or `--policy`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum LevelPolicy {
     /// Every creature at the point-mass level.
     #[default]
@@ -134,6 +133,47 @@ pub enum LevelPolicy {
 }
 
 impl LevelPolicy {
+    /// Every policy, in the order the command line lists them.
+    pub const ALL: [LevelPolicy; 7] = [
+        LevelPolicy::AllPointMass,
+        LevelPolicy::AllHybrid,
+        LevelPolicy::AllRigid,
+        LevelPolicy::Influence,
+        LevelPolicy::Camera,
+        LevelPolicy::Combined,
+        LevelPolicy::Budget,
+    ];
+
+    /// The name used on the command line, in reports and in the game (`all-point-mass`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LevelPolicy::AllPointMass => "all-point-mass",
+            LevelPolicy::AllHybrid => "all-hybrid",
+            LevelPolicy::AllRigid => "all-rigid",
+            LevelPolicy::Influence => "influence",
+            LevelPolicy::Camera => "camera",
+            LevelPolicy::Combined => "combined",
+            LevelPolicy::Budget => "budget",
+        }
+    }
+
+    /// What the policy does, in a line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            LevelPolicy::AllPointMass => "Every creature at the point-mass level",
+            LevelPolicy::AllHybrid => "Every creature at the hybrid level",
+            LevelPolicy::AllRigid => "Every creature at the rigid level",
+            LevelPolicy::Influence => "Areas of influence (figure 5): rigid inside another's area, else hybrid",
+            LevelPolicy::Camera => {
+                "The camera rule (figure 6): rigid in view and near, hybrid in view, else point mass"
+            }
+            LevelPolicy::Combined => "The more detailed of the two",
+            LevelPolicy::Budget => {
+                "A frame budget: each creature's level chosen so that the predicted cost stays within it, spent where a contact is soonest and the view nearest (beyond the paper)"
+            }
+        }
+    }
+
     /// Whether the policy reads the puck's radius of influence (figure 8).
     pub fn uses_puck_radius(self) -> bool {
         matches!(self, Self::Influence | Self::Combined)

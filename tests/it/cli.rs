@@ -3,7 +3,7 @@
 use std::process::{Command, Output};
 
 fn simlod(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_simlod"))
+    Command::new(crate::support::simlod_bin())
         .args(args)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .output()
@@ -288,7 +288,7 @@ fn assets_moves_everything_the_default_scenario_included_and_scenarios_are_found
     std::fs::write(assets.join("scenarios/default.ron"), seven).unwrap();
     let elsewhere = std::env::temp_dir();
     let run = |args: &[&str]| {
-        let out = Command::new(env!("CARGO_BIN_EXE_simlod"))
+        let out = Command::new(crate::support::simlod_bin())
             .args(args)
             .current_dir(&elsewhere)
             .output()

@@ -1,7 +1,7 @@
 //! The paper's experiments write their data.
 
 use crate::support::*;
-use simlod::experiments::step_response;
+use simlod_lab::experiments::step_response;
 
 #[test]
 fn step_response_writes_velocities_and_paths_that_follow_the_steps() {
@@ -79,9 +79,9 @@ fn step_response_refuses_a_broken_experiment_file() {
     assert!(err.contains("`duration_s`") && err.contains("`steps`"), "{err}");
 }
 
-use simlod::experiments::{self, Options, Shard};
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
+use simlod_lab::experiments::{self, Options, Shard};
 use std::path::{Path, PathBuf};
 
 /// Each file an experiment's output says it wrote ("wrote a.csv, b.png and report.md in DIR",
@@ -512,7 +512,7 @@ fn every_figure_keeps_its_legend_and_labels_inside_and_off_the_data() {
     // figure, over another label or over a data marker) it says on standard error.
     let out = scratch_dir("experiments_layout");
     for name in experiments::report::ORDER {
-        let run = std::process::Command::new(env!("CARGO_BIN_EXE_simlod"))
+        let run = std::process::Command::new(crate::support::simlod_bin())
             .args(["experiment", name, "--quick", "--out"])
             .arg(&out)
             .output()

@@ -13,15 +13,14 @@ use std::time::Instant;
 
 use crate::assets::assets_with;
 use crate::support::*;
-use clap::ValueEnum;
 use proptest::strategy::Strategy;
 use simlod::config::{ConfigError, SimConfig, load_file};
-use simlod::experiments::{
+use simlod::headless::HeadlessSim;
+use simlod::lod::LevelPolicy;
+use simlod_lab::experiments::{
     ExperimentFile, budget::BudgetSettings, crowd::CrowdSettings, fig7::Fig7Settings, fig10::Fig10Settings,
     frame_rate::FrameRateSettings, step_response::StepResponseConfig, table1::Table1Settings,
 };
-use simlod::headless::HeadlessSim;
-use simlod::lod::LevelPolicy;
 use std::path::Path;
 
 /// The files the default scenario loads: the scenario, and every file it names.
@@ -248,7 +247,7 @@ fn mutated_asset_files_are_refused_or_run_never_panic() {
     for case in 0..cases {
         let files = [&SIMULATION_FILES[..], &EXPERIMENT_FILES[..]].concat();
         let file = files[rng.random_range(0..files.len())];
-        let policy = LevelPolicy::value_variants()[rng.random_range(0..LevelPolicy::value_variants().len())];
+        let policy = LevelPolicy::ALL[rng.random_range(0..LevelPolicy::ALL.len())];
         let original = std::fs::read(assets_root().join(file)).unwrap();
         let mut bytes = original.clone();
         let what: Vec<String> = (0..rng.random_range(1..=3))

@@ -5,10 +5,10 @@ use bevy::prelude::*;
 use crate::support::*;
 use simlod::config::{ConfigError, SimConfig, load_file};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
-use simlod::experiments::{lone_creature, stand};
-use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::gait::{GaitPose, GaitTable, columns};
 use simlod::lod::{LevelPolicy, Lod};
+use simlod_lab::experiments::{lone_creature, stand};
+use simlod_lab::record::{RecordSettings, record, to_file_text};
 
 const SHIPPED: &str = "gaits/hopper.ron";
 

@@ -12,11 +12,11 @@ use simlod::SimPlugin;
 use simlod::arena::PuckState;
 use simlod::config::{GameConfig, SimConfig, load_file};
 use simlod::creature::PlanarState;
-use simlod::game::GameSettings;
-use simlod::game::player::{BaseConfig, NewRound, PlayerIntent, Round};
-use simlod::game::reload::{Problems, Watched};
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
+use simlod_game::GameSettings;
+use simlod_game::player::{BaseConfig, NewRound, PlayerIntent, Round};
+use simlod_game::reload::{Problems, Watched};
 
 fn player_state(app: &mut App) -> Option<PlanarState> {
     let player = app.world().resource::<Round>().player?;
@@ -29,7 +29,7 @@ fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
     let mut config = config_with_hoppers(10);
     config.scenario.level_policy = LevelPolicy::AllPointMass;
     let mut sim = HeadlessSim::new(config);
-    simlod::game::player::plugin(&mut sim.app);
+    simlod_game::player::plugin(&mut sim.app);
     sim.advance_frame();
     let start = player_state(&mut sim.app).expect("a creature is the player's");
     // Away from the puck, toward the court's centre line.
@@ -98,8 +98,8 @@ fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) 
         file_rules,
     ))
     .insert_resource(TimeUpdateStrategy::FixedTimesteps(8));
-    simlod::game::player::plugin(&mut app);
-    simlod::game::reload::plugin(&mut app);
+    simlod_game::player::plugin(&mut app);
+    simlod_game::reload::plugin(&mut app);
     app.finish();
     app.cleanup();
     app
@@ -207,7 +207,7 @@ fn the_shipped_game_file_loads_and_a_bad_colour_is_named() {
 
 #[test]
 fn without_a_display_the_game_says_so_in_one_sentence_and_points_to_run() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_simlod"))
+    let out = std::process::Command::new(crate::support::simlod_bin())
         .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
@@ -343,8 +343,8 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
     use bevy::window::{ExitCondition, WindowPlugin, WindowResolution};
     use simlod::creature::{Creature, KindTable};
     use simlod::gait::GaitPose;
-    use simlod::game::view::FollowCamera;
     use simlod::lod::Lod;
+    use simlod_game::view::FollowCamera;
 
     let mut config = default_config();
     config.scenario.level_policy = LevelPolicy::Camera;
@@ -368,8 +368,8 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
         ))
         .insert_resource(GameSettings(looks))
         .insert_resource(TimeUpdateStrategy::FixedTimesteps(ticks_per_frame));
-    simlod::game::player::plugin(&mut app);
-    simlod::game::view::plugin(&mut app);
+    simlod_game::player::plugin(&mut app);
+    simlod_game::view::plugin(&mut app);
     app.finish();
     app.cleanup();
     app.update();

@@ -9,11 +9,11 @@ use std::path::{Path, PathBuf};
 use crate::support::*;
 use simlod::config::{CreatureDef, SimConfig, Stance, load_file};
 use simlod::creature::{Creature, PlanarState};
-use simlod::gait::record::{RecordSettings, record, to_file_text};
 use simlod::gait::{GaitPose, GaitRow, GaitTable, columns};
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::RigidPart;
+use simlod_lab::record::{RecordSettings, record, to_file_text};
 
 /// The tests' own asset folder, copied to a scratch folder of `name` (a test may add to it).
 fn fixture_assets(name: &str) -> PathBuf {

@@ -10,7 +10,6 @@ mod docs;
 mod experiments;
 mod fuzz;
 mod gait;
-#[cfg(feature = "game")]
 mod game;
 mod kinds;
 mod outcome;

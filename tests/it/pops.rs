@@ -7,9 +7,9 @@ use bevy::prelude::*;
 use crate::support::*;
 use simlod::config::SimConfig;
 use simlod::creature::DesiredVelocity;
-use simlod::experiments::lone_creature;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::Shove;
+use simlod_lab::experiments::lone_creature;
 
 /// A game of the shipped kinds under the combined policy, blended as the shipped rules say or
 /// not at all.

@@ -3,7 +3,6 @@
 use bevy_rapier3d::prelude::RigidBody;
 
 use crate::support::*;
-use clap::ValueEnum;
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
 use simlod::models::rigid::RigidPart;
@@ -12,7 +11,7 @@ use simlod::start_over;
 /// Under every policy: the rigid ones rebuild rapier's world, which must start empty too.
 #[test]
 fn starting_over_gives_the_same_world_as_a_fresh_start() {
-    for &policy in LevelPolicy::value_variants() {
+    for policy in LevelPolicy::ALL {
         let mut config = default_config();
         config.scenario.level_policy = policy;
         let mut fresh = HeadlessSim::new(config.clone());

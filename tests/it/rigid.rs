@@ -8,10 +8,10 @@ use bevy_rapier3d::prelude::*;
 use crate::support::*;
 use simlod::config::{RigidJoints, SimConfig};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
-use simlod::experiments::{lone_creature, stand};
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::{RigidBodies, RigidPart, Shove};
+use simlod_lab::experiments::{lone_creature, stand};
 
 /// One rigid hopper steered from outside at `desired`, far from the walls and the parked puck.
 pub fn lone_hopper(desired: Vec2) -> (HeadlessSim, Entity) {

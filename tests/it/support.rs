@@ -5,6 +5,24 @@ use simlod::config::SimConfig;
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
 
+/// The `simlod` binary, built by the CLI crate beside these tests (`cargo test` at the
+/// workspace's root builds it first).
+pub fn simlod_bin() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test binary's path");
+    // target/<profile>/deps/it-<hash>: the binary is in target/<profile>.
+    let bin = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("a target folder")
+        .join("simlod");
+    assert!(
+        bin.exists(),
+        "{} is not built: run the tests from the workspace's root (`cargo test --release`)",
+        bin.display()
+    );
+    bin
+}
+
 pub fn assets_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("assets")
 }

@@ -2,10 +2,10 @@
 //! every creature counted, placed in bounded time.
 
 use crate::support::*;
-use simlod::bench::scaled;
 use simlod::config::{Validate, Validator};
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
+use simlod_lab::bench::scaled;
 
 /// Whether the scenario's checks accept these rates.
 fn allowed(tick_hz: u32, decision_hz: u32) -> bool {

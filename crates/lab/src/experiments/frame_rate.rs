@@ -10,8 +10,8 @@ use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings, median_of, timed_game, trials};
-use crate::config::{LevelRules, SimConfig, Validate, Validator, load_file};
-use crate::lod::{LevelPolicy, Lod};
+use simlod::config::{LevelRules, SimConfig, Validate, Validator, load_file};
+use simlod::lod::{LevelPolicy, Lod};
 
 /// The radius an experiment sweeps.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -64,7 +64,7 @@ impl Validate for FrameRateSettings {
                 "must name a rules file",
             );
         }
-        v.within("seconds", self.seconds, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.within("seconds", self.seconds, 1.0 / 30.0, simlod::config::MAX_DURATION_S);
         v.require(self.trials >= 1, "trials", "must be at least 1");
     }
 }
@@ -252,7 +252,7 @@ pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Re
         report,
         "\n\nAny row reruns alone: `simlod run --scenario {} --seed SEED --policy {} --rules RULES --{flag}-radius R --seconds {}` prints the same level counts.\n",
         options.scenario.display(),
-        policy_flag(s.policy),
+        s.policy.name(),
         s.seconds
     );
     ExperimentRecord {
@@ -263,12 +263,4 @@ pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Re
         smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
-}
-
-/// A policy as `--policy` spells it.
-pub fn policy_flag(policy: LevelPolicy) -> String {
-    use clap::ValueEnum;
-    policy
-        .to_possible_value()
-        .map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
 }

@@ -6,7 +6,7 @@ use plotters::style::{FontStyle, register_font};
 use std::path::Path;
 use std::sync::Once;
 
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+static FONT: &[u8] = include_bytes!("../../../../assets/fonts/DejaVuSans.ttf");
 
 /// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -108,8 +108,8 @@ pub const REFERENCE: usize = 5;
 
 /// One colour per level policy, the same in every figure. A budget used as a ceiling takes
 /// [`BUDGET_CEILING`].
-pub fn policy_colour(policy: crate::lod::LevelPolicy) -> usize {
-    use crate::lod::LevelPolicy::*;
+pub fn policy_colour(policy: simlod::lod::LevelPolicy) -> usize {
+    use simlod::lod::LevelPolicy::*;
     match policy {
         Influence => 0,
         AllHybrid => 1,

@@ -10,13 +10,13 @@ use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, check_kind, command, hold_levels, load_settings, median_of, only_kind, trials};
-use crate::SimStage;
 use crate::bench::{median_frame_seconds, median_frame_seconds_of, scaled};
-use crate::config::{SimConfig, Validate, Validator};
-use crate::creature::KindTable;
-use crate::creature::{DesiredVelocity, PlanarState};
-use crate::headless::HeadlessSim;
-use crate::lod::{LevelPolicy, Lod};
+use simlod::SimStage;
+use simlod::config::{SimConfig, Validate, Validator};
+use simlod::creature::KindTable;
+use simlod::creature::{DesiredVelocity, PlanarState};
+use simlod::headless::HeadlessSim;
+use simlod::lod::{LevelPolicy, Lod};
 
 /// The paper's Table 1 (SGI R10000): ms per creature per 1/30 s, point mass, hybrid, rigid.
 pub const PAPER_MS: [f64; 3] = [0.0025, 0.024, 2.4];

@@ -13,13 +13,13 @@ use bevy::prelude::*;
 use super::GameSettings;
 use super::player::Round;
 use super::scene::{Palette, srgb};
-use crate::SimClock;
-use crate::SimEntity;
-use crate::config::SimConfig;
-use crate::creature::{Creature, KindTable, PlanarState};
-use crate::gait::GaitPose;
-use crate::lod::{Lod, SwitchBlend, drawn};
-use crate::models::point_mass::FrameStepping;
+use simlod::SimClock;
+use simlod::SimEntity;
+use simlod::config::SimConfig;
+use simlod::creature::{Creature, KindTable, PlanarState};
+use simlod::gait::GaitPose;
+use simlod::lod::{Lod, SwitchBlend, drawn};
+use simlod::models::point_mass::FrameStepping;
 
 /// Rapier's bodies face +x; a pose faces -z.
 const RAPIER_TO_POSE: Quat = Quat::from_xyzw(

@@ -2,14 +2,13 @@
 //! paper's figures 8 and 9 vary (the level policy and the radii of influence).
 
 use bevy::prelude::*;
-use clap::ValueEnum;
 
 use super::GameSettings;
 use super::player::{BaseConfig, NewRound, PlayerIntent};
 use super::scene::ColourByLevel;
 use super::view::FollowCamera;
-use crate::config::SimConfig;
-use crate::lod::LevelPolicy;
+use simlod::config::SimConfig;
+use simlod::lod::LevelPolicy;
 
 /// The keys, as the HUD lists them: only those that do something under `policy`.
 pub fn controls_help(policy: LevelPolicy) -> String {
@@ -108,12 +107,12 @@ fn read_game_keys(
     if keys.just_pressed(KeyCode::KeyL) {
         // Every policy there is, in turn, live: each creature moves to its new level in its
         // next flight window (paper 3.4); later rounds keep the policy.
-        let all = LevelPolicy::value_variants();
+        let all = LevelPolicy::ALL;
         let now = all.iter().position(|&p| p == config.scenario.level_policy).unwrap_or(0);
         let next = all[(now + 1) % all.len()];
         config.scenario.level_policy = next;
         base.scenario.level_policy = next;
-        say(format!("level policy {}", policy_name(next)));
+        say(format!("level policy {}", next.name()));
     }
     // The puck's radius of influence (figure 8) and the camera's (figure 9), live: the
     // rules decide levels at every decision, so the change shows at once (paper 3.4).
@@ -134,10 +133,7 @@ fn read_game_keys(
                 if which.used_by(config.scenario.level_policy) {
                     String::new()
                 } else {
-                    format!(
-                        " (the {} policy does not use it)",
-                        policy_name(config.scenario.level_policy)
-                    )
+                    format!(" (the {} policy does not use it)", config.scenario.level_policy.name())
                 }
             ));
         }
@@ -156,10 +152,7 @@ fn read_game_keys(
                 if config.scenario.level_policy.uses_frame_budget() {
                     String::new()
                 } else {
-                    format!(
-                        " (the {} policy does not use it)",
-                        policy_name(config.scenario.level_policy)
-                    )
+                    format!(" (the {} policy does not use it)", config.scenario.level_policy.name())
                 }
             ));
         }
@@ -197,12 +190,6 @@ impl Radius {
 }
 
 /// A policy as the command line spells it.
-pub fn policy_name(policy: LevelPolicy) -> String {
-    policy
-        .to_possible_value()
-        .map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
-}
-
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<Notice>()
         .init_resource::<ShowFigures>()
@@ -212,15 +199,15 @@ pub(super) fn plugin(app: &mut App) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::load_file;
-    use crate::{SimPlugin, lod::LevelPolicy};
+    use simlod::config::load_file;
+    use simlod::{SimPlugin, lod::LevelPolicy};
     use std::path::Path;
 
     fn app_with_keys(policy: LevelPolicy) -> App {
         let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
         let mut config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
         config.scenario.level_policy = policy;
-        let looks = load_file(&root.join(crate::game::GAME_FILE)).unwrap();
+        let looks = load_file(&root.join(crate::GAME_FILE)).unwrap();
         let mut app = App::new();
         app.add_plugins(MinimalPlugins)
             .add_plugins(SimPlugin { config })
@@ -276,7 +263,7 @@ mod tests {
         let serials = |app: &mut App| {
             let world = app.world_mut();
             let mut s: Vec<u32> = world
-                .query::<&crate::creature::Creature>()
+                .query::<&simlod::creature::Creature>()
                 .iter(world)
                 .map(|c| c.serial)
                 .collect();

@@ -20,10 +20,10 @@ use bevy::prelude::*;
 use bevy::window::WindowResolution;
 use std::path::{Path, PathBuf};
 
-use crate::SimPlugin;
-use crate::config::{GameConfig, SimConfig, load_file};
-use crate::lod::LevelPolicy;
 pub use capture::{Capture, CapturePlan};
+use simlod::SimPlugin;
+use simlod::config::{GameConfig, SimConfig, load_file};
+use simlod::lod::LevelPolicy;
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {

@@ -12,9 +12,9 @@ use std::path::{Path, PathBuf};
 
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, Shard, command, load_settings, mean_and_variance, run_parallel, trials};
-use crate::config::{LevelRules, SimConfig, Validate, Validator, load_file};
-use crate::headless;
-use crate::lod::{LevelPolicy, Lod};
+use simlod::config::{LevelRules, SimConfig, Validate, Validator, load_file};
+use simlod::headless;
+use simlod::lod::{LevelPolicy, Lod};
 
 /// `assets/experiments/fig10.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -44,7 +44,7 @@ impl Validate for Fig10Settings {
             "rules",
             "must name a rules file (without commas or quotes)",
         );
-        v.within("seconds", self.seconds, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.within("seconds", self.seconds, 1.0 / 30.0, simlod::config::MAX_DURATION_S);
         v.require(self.trials >= 1, "trials", "must be at least 1");
     }
 }

@@ -5,9 +5,9 @@ use bevy::prelude::*;
 
 use super::GameSettings;
 use super::player::Round;
-use crate::arena::PuckState;
-use crate::creature::PlanarState;
-use crate::lod::{CameraFromView, SimCamera};
+use simlod::arena::PuckState;
+use simlod::creature::PlanarState;
+use simlod::lod::{CameraFromView, SimCamera};
 
 /// The player's view. The HUD is drawn on it.
 #[derive(Component)]

@@ -13,9 +13,9 @@ use super::{EXPERIMENT_COURT_M, ExperimentRecord, lone_creature, write_out};
 
 /// A run starts at least this far inside the experiment's court: 8 s at 3 m/s is 24 m.
 const START_MARGIN_M: f32 = 50.0;
-use crate::config::{ConfigError, SimConfig, Validate, Validator, load_file};
-use crate::creature::{DesiredVelocity, PlanarState};
-use crate::lod::{LevelPolicy, Lod};
+use simlod::config::{ConfigError, SimConfig, Validate, Validator, load_file};
+use simlod::creature::{DesiredVelocity, PlanarState};
+use simlod::lod::{LevelPolicy, Lod};
 
 /// `assets/experiments/step_response.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -43,7 +43,12 @@ pub struct VelocityStep {
 
 impl Validate for StepResponseConfig {
     fn validate(&self, v: &mut Validator) {
-        v.within("duration_s", self.duration_s, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.within(
+            "duration_s",
+            self.duration_s,
+            1.0 / 30.0,
+            simlod::config::MAX_DURATION_S,
+        );
         // The run must stay in the experiment's court: a start well inside it.
         let reach = EXPERIMENT_COURT_M / 2.0 - START_MARGIN_M;
         v.within("start_m.0", self.start_m.0, -reach, reach);

@@ -3,7 +3,6 @@
 //! few seconds with every frame's simulation timed: the mean and slowest frame, and the
 //! creatures at each level. A policy stops at the first size where a frame passes the limit.
 
-use clap::ValueEnum;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -12,9 +11,9 @@ use std::time::Instant;
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings};
 use crate::bench::scaled;
-use crate::config::{SimConfig, Validate, Validator};
-use crate::headless::HeadlessSim;
-use crate::lod::{LevelPolicy, Lod};
+use simlod::config::{SimConfig, Validate, Validator};
+use simlod::headless::HeadlessSim;
+use simlod::lod::{LevelPolicy, Lod};
 
 /// `assets/experiments/crowd.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -42,11 +41,11 @@ impl Validate for CrowdSettings {
         );
         for (i, &n) in self.creatures.iter().enumerate() {
             v.require(
-                (1..=crate::config::MAX_CREATURES).contains(&n),
+                (1..=simlod::config::MAX_CREATURES).contains(&n),
                 &format!("creatures[{i}]"),
                 format!(
                     "must be between 1 and {} creatures, got {n}",
-                    crate::config::MAX_CREATURES
+                    simlod::config::MAX_CREATURES
                 ),
             );
         }
@@ -73,15 +72,9 @@ struct Game {
 }
 
 /// The policy's name on the command line (`all-rigid`).
-fn name_of(policy: LevelPolicy) -> String {
-    policy
-        .to_possible_value()
-        .map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
-}
-
 /// A game of `config` for `seconds`, each frame timed, ended early by a frame over `stop_ms`.
 fn game(config: SimConfig, seconds: f32, stop_ms: f64) -> Game {
-    let (policy, creatures) = (name_of(config.scenario.level_policy), config.scenario.creature_count());
+    let (policy, creatures) = (config.scenario.level_policy.name(), config.scenario.creature_count());
     let mut sim = HeadlessSim::new(config);
     // The first frame builds the world: not a frame of the game.
     sim.advance_frame();
@@ -97,7 +90,7 @@ fn game(config: SimConfig, seconds: f32, stop_ms: f64) -> Game {
     let summary = sim.summary(frames_ms.iter().sum::<f64>() / 1e3);
     let slowest = frames_ms.iter().copied().fold(0.0, f64::max);
     Game {
-        policy,
+        policy: policy.to_owned(),
         creatures,
         frames: frames_ms.len(),
         mean_frame_ms: frames_ms.iter().sum::<f64>() / frames_ms.len().max(1) as f64,
@@ -165,7 +158,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     };
     let mut series = Vec::new();
     for &policy in &s.policies {
-        let (name, colour) = (name_of(policy), plot::policy_colour(policy));
+        let (name, colour) = (policy.name(), plot::policy_colour(policy));
         series.push(Series::new(
             format!("{name}, mean"),
             curve(&name, |g| g.mean_frame_ms),

@@ -1,6 +1,7 @@
 //! The `simlod` command line: the game (the default), the headless simulation and its
 //! measurements.
 
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -9,10 +10,11 @@ use simlod::config::{
     CreatureDef, CreatureGroup, MAX_DURATION_S, MeasuredAnew, SimConfig, Validate, Validator, load_costs, load_file,
 };
 use simlod::gait::GaitTable;
-use simlod::gait::record::{RecordSettings, record, to_file_text};
+use simlod::headless;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::{Counts, Key, Summary};
-use simlod::{bench, experiments, headless};
+use simlod_lab::record::{RecordSettings, record, to_file_text};
+use simlod_lab::{bench, experiments};
 
 #[derive(Parser)]
 #[command(
@@ -280,7 +282,7 @@ struct ScenarioArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Overrides the scenario's level policy.
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = policy_parser())]
     policy: Option<LevelPolicy>,
     /// Overrides the radius of the puck's area of influence (metres).
     #[arg(long, allow_negative_numbers = true, value_parser = non_negative_metres)]
@@ -363,7 +365,7 @@ impl ScenarioArgs {
 
     fn what_ran(&self, config: &SimConfig) -> WhatRan {
         WhatRan {
-            policy: policy_name(config.scenario.level_policy),
+            policy: config.scenario.level_policy.name().to_owned(),
             rules: self
                 .rules
                 .clone()
@@ -422,7 +424,7 @@ struct PlayArgs {
     #[arg(long, default_value = "assets")]
     assets: PathBuf,
     /// Overrides the scenario's level policy (L switches it while playing).
-    #[arg(long, value_enum)]
+    #[arg(long, value_parser = policy_parser())]
     policy: Option<LevelPolicy>,
     /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s, 0 to 10000; 9
     /// and 0 change it while playing).
@@ -444,18 +446,18 @@ struct PlayArgs {
 impl PlayArgs {
     fn play(self) -> Result<(), String> {
         let runtime_dir = private_runtime_dir();
-        let played = simlod::game::play(simlod::game::PlayOptions {
+        let played = simlod_game::play(simlod_game::PlayOptions {
             scenario: scenario_file(&self.assets, self.scenario.as_deref()),
             assets: self.assets,
             policy: self.policy,
             frame_budget_ms: self.frame_budget,
             capture: self.frames.and_then(|frames| {
                 let (path, kind) = match (self.screenshot, self.record) {
-                    (Some(path), _) => (path, simlod::game::Capture::Screenshot),
-                    (None, Some(path)) => (path, simlod::game::Capture::Recording),
+                    (Some(path), _) => (path, simlod_game::Capture::Screenshot),
+                    (None, Some(path)) => (path, simlod_game::Capture::Recording),
                     (None, None) => return None,
                 };
-                Some(simlod::game::CapturePlan { path, frames, kind })
+                Some(simlod_game::CapturePlan { path, frames, kind })
             }),
         });
         if let Some(dir) = runtime_dir {
@@ -517,7 +519,7 @@ impl RunArgs {
         if let Some((flag, _)) = unread.iter().find(|(_, unread)| *unread) {
             return Err(format!(
                 "{flag} does not apply to the {} policy, which never reads it (choose a policy that does with --policy)",
-                policy_name(policy)
+                policy.name()
             ));
         }
         let seconds = self.seconds.unwrap_or(f64::from(config.scenario.duration_s));
@@ -544,8 +546,21 @@ struct WhatRan {
     cost_model: PathBuf,
 }
 
-fn policy_name(policy: LevelPolicy) -> String {
-    clap::ValueEnum::to_possible_value(&policy).map_or_else(|| format!("{policy:?}"), |v| v.get_name().to_owned())
+/// `--policy`: a policy by its name, each listed with its line of help.
+fn policy_parser() -> impl TypedValueParser<Value = LevelPolicy> {
+    PossibleValuesParser::new(LevelPolicy::ALL.map(|p| PossibleValue::new(p.name()).help(p.describe()))).map(|name| {
+        *LevelPolicy::ALL
+            .iter()
+            .find(|p| p.name() == name)
+            .expect("a listed name")
+    })
+}
+
+/// `--level`: a level by its name (`point-mass`), each listed with its line of help.
+fn level_parser() -> impl TypedValueParser<Value = Lod> {
+    let flag = |l: Lod| l.name().replace('_', "-");
+    PossibleValuesParser::new(Lod::ALL.map(|l| PossibleValue::new(flag(l)).help(l.describe())))
+        .map(move |name| *Lod::ALL.iter().find(|&&l| flag(l) == name).expect("a listed name"))
 }
 
 #[derive(Args)]
@@ -559,7 +574,7 @@ struct BenchArgs {
     #[arg(long)]
     quick: bool,
     /// Only this level (no cost ratios, no game).
-    #[arg(long, value_enum, conflicts_with = "calibrate")]
+    #[arg(long, value_parser = level_parser(), conflicts_with = "calibrate")]
     level: Option<Lod>,
     /// Only the scenario's creatures of this kind (for example `biped`): its cost at each level.
     #[arg(long, conflicts_with = "calibrate")]

@@ -12,11 +12,11 @@ use std::path::PathBuf;
 
 use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
-use crate::config::{
+use simlod::config::{
     ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file,
     load_costs, resolve_reference,
 };
-use crate::gait::GaitTable;
+use simlod::gait::GaitTable;
 
 /// The files the game watches, and whether one changed since the config was last put
 /// together from them.

@@ -10,10 +10,10 @@ use std::path::Path;
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, check_kind, command, hold_levels, load_settings, median_of, only_kind, trials};
 use crate::bench::{median_frame_seconds_of, most_within_budget, scaled};
-use crate::config::{SimConfig, Validate, Validator};
-use crate::creature::Creature;
-use crate::headless::HeadlessSim;
-use crate::lod::{LevelChoice, LevelPolicy, Lod};
+use simlod::config::{SimConfig, Validate, Validator};
+use simlod::creature::Creature;
+use simlod::headless::HeadlessSim;
+use simlod::lod::{LevelChoice, LevelPolicy, Lod};
 
 /// The paper's figure 7 without graphics: 112 creatures all hybrid, 12 all rigid.
 pub const PAPER_ENDS: [(f64, f64); 2] = [(0.0, 112.0), (100.0, 12.0)];
@@ -130,7 +130,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
          the search doubles and then halves the gap to within 3 %. Loops over more than {} creatures run on both cores.\n\n\
          | rigid (%) | creatures at 30 fps |\n|---|---|\n",
         s.frames,
-        crate::PARALLEL_MIN_CREATURES
+        simlod::PARALLEL_MIN_CREATURES
     );
     for (p, n) in &points {
         let _ = writeln!(report, "| {p} | {n} |");

@@ -11,7 +11,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use std::path::{Path, PathBuf};
 
 use super::GameSettings;
-use crate::SimClock;
+use simlod::SimClock;
 
 /// What to save, and after how many frames.
 #[derive(Clone, Debug)]
@@ -171,7 +171,7 @@ pub(super) fn plugin(app: &mut App, plan: CapturePlan) {
     // A frame is one steering decision's ticks, every one of them run (at 1 Hz decisions a
     // frame is a second of simulation, more than Bevy lets through an update by default).
     let ticks = app.world().resource::<SimClock>().ticks_per_decision;
-    crate::headless::run_ticks_per_update(app.world_mut(), ticks);
+    simlod::headless::run_ticks_per_update(app.world_mut(), ticks);
     app.insert_resource(Capturing {
         plan: CapturePlan {
             frames: plan.frames.max(1),

@@ -9,10 +9,10 @@
 use serde::Serialize;
 use std::time::Instant;
 
-use crate::config::{CostModel, KindCosts, LevelCosts, SimConfig};
-use crate::creature::KindTable;
-use crate::headless::HeadlessSim;
-use crate::lod::{LevelPolicy, Lod};
+use simlod::config::{CostModel, KindCosts, LevelCosts, SimConfig};
+use simlod::creature::KindTable;
+use simlod::headless::HeadlessSim;
+use simlod::lod::{LevelPolicy, Lod};
 
 /// Wall-clock budget of one frame at 30 fps.
 const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
@@ -141,9 +141,9 @@ fn bench_level(config: &SimConfig, level: Lod, policy: LevelPolicy, effort: &Eff
 pub fn most_within_budget(search_from: u32, steps: u32, mut frame_s: impl FnMut(u32) -> f64) -> u32 {
     let mut fits = |n: u32| frame_s(n) <= FRAME_BUDGET_S;
     let (mut good, mut bad) = (0u32, search_from.max(1));
-    while bad < crate::config::MAX_CREATURES && fits(bad) {
+    while bad < simlod::config::MAX_CREATURES && fits(bad) {
         good = bad;
-        bad = (bad * 2).min(crate::config::MAX_CREATURES);
+        bad = (bad * 2).min(simlod::config::MAX_CREATURES);
     }
     for _ in 0..steps {
         if bad - good <= good / 32 + 1 {
@@ -274,7 +274,7 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
 /// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
 /// of the scenario alone, in a court scaled to its density: each level's median frame, less
-/// the fixed cost, divided by the creatures (fewer than [`crate::PARALLEL_MIN_CREATURES`], so
+/// the fixed cost, divided by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so
 /// one thread, as in a game), and the switch into the rigid level (see `switch_cost_us`). A
 /// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
 /// policy's own choice per creature, in the scenario's mix scaled up.

@@ -2,8 +2,6 @@
 //! few steady speeds, one hop from touchdown to touchdown at 30 samples a second, and looked
 //! up by linear interpolation in speed and in phase.
 
-pub mod record;
-
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -71,7 +69,8 @@ impl LegPose {
         }
     }
 
-    fn lerp(self, other: Self, t: f32) -> Self {
+    /// The pose a fraction `t` of the way from this one to `other`.
+    pub fn lerp(self, other: Self, t: f32) -> Self {
         Self {
             length_m: self.length_m + (other.length_m - self.length_m) * t,
             forward_rad: self.forward_rad + (other.forward_rad - self.forward_rad) * t,
@@ -172,7 +171,8 @@ impl GaitPose {
         pose
     }
 
-    fn lerp(self, other: Self, t: f32) -> Self {
+    /// The pose a fraction `t` of the way from this one to `other`, leg by leg.
+    pub fn lerp(self, other: Self, t: f32) -> Self {
         let mut pose = Self {
             body_height_m: self.body_height_m + (other.body_height_m - self.body_height_m) * t,
             roll_rad: self.roll_rad + (other.roll_rad - self.roll_rad) * t,

@@ -21,9 +21,9 @@ use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings, mean_and_variance, run_parallel, timed_game, trials};
-use crate::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
-use crate::lod::{LevelPolicy, Lod};
-use crate::outcome::{Counts, Obstacle};
+use simlod::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
+use simlod::lod::{LevelPolicy, Lod};
+use simlod::outcome::{Counts, Obstacle};
 
 /// `assets/experiments/budget.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -74,7 +74,7 @@ impl Validate for BudgetSettings {
         }
         v.asset_path("fixed_rules", &self.fixed_rules);
         v.asset_path("budget_rules", &self.budget_rules);
-        v.within("seconds", self.seconds, 1.0 / 30.0, crate::config::MAX_DURATION_S);
+        v.within("seconds", self.seconds, 1.0 / 30.0, simlod::config::MAX_DURATION_S);
         v.require(self.trials >= 1, "trials", "must be at least 1");
         v.require(
             (1..=100_000).contains(&self.crowd_creatures),
@@ -180,7 +180,7 @@ impl Row {
 /// The two rules files, read from the assets folder with the budget rules' cost model.
 struct Rules {
     fixed: LevelRules,
-    budget: (LevelRules, crate::config::CostModel),
+    budget: (LevelRules, simlod::config::CostModel),
 }
 
 fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[Setting], trial: u32) -> Vec<Row> {

@@ -12,12 +12,12 @@
 use bevy::prelude::*;
 use std::fmt::Write as _;
 
-use super::{GaitPose, GaitRow, GaitTable, columns};
-use crate::config::{CreatureDef, SimConfig};
-use crate::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use crate::experiments::{EXPERIMENT_COURT_M, lone_creature, stand};
-use crate::headless::HeadlessSim;
-use crate::lod::LevelPolicy;
+use simlod::config::{CreatureDef, SimConfig};
+use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
+use simlod::gait::{GaitPose, GaitRow, GaitTable, columns};
+use simlod::headless::HeadlessSim;
+use simlod::lod::LevelPolicy;
 
 /// How a table is recorded.
 #[derive(Clone, Debug)]

@@ -10,8 +10,8 @@ use super::GameSettings;
 use super::creatures::OVERHEAD_ONLY;
 use super::scene::srgb;
 use super::view::{FollowCamera, ViewSystems};
-use crate::arena::Court;
-use crate::config::SimConfig;
+use simlod::arena::Court;
+use simlod::config::SimConfig;
 
 /// The overhead view of the whole court.
 #[derive(Component)]

@@ -6,10 +6,10 @@
 
 use bevy::prelude::*;
 
-use crate::config::SimConfig;
-use crate::creature::{Creature, DesiredVelocity, KindTable, PlayerControlled};
-use crate::outcome::CollisionRecord;
-use crate::{SimClock, SimStage, start_over};
+use simlod::config::SimConfig;
+use simlod::creature::{Creature, DesiredVelocity, KindTable, PlayerControlled};
+use simlod::outcome::CollisionRecord;
+use simlod::{SimClock, SimStage, start_over};
 
 /// The config each new round starts from: the files' last good values, with the player's
 /// live tuning (the level policy, the radii of influence).
@@ -120,7 +120,7 @@ fn start_rounds(
 }
 
 /// The player's creature and its rounds: everything of the game that needs no window.
-/// Add after [`crate::SimPlugin`]: the first round is the world it built.
+/// Add after [`simlod::SimPlugin`]: the first round is the world it built.
 pub fn plugin(app: &mut App) {
     let base = BaseConfig(app.world().resource::<SimConfig>().clone());
     app.insert_resource(base)

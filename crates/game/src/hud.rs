@@ -8,15 +8,15 @@ use std::fmt::Write;
 use std::time::Instant;
 
 use super::GameSettings;
-use super::controls::{Notice, ShowFigures, controls_help, policy_name};
+use super::controls::{Notice, ShowFigures, controls_help};
 use super::player::Round;
 use super::reload::Problems;
 use super::scene::{ColourByLevel, srgb};
-use crate::SimClock;
-use crate::config::SimConfig;
-use crate::lod::PopTally;
-use crate::lod::{BudgetTally, Lod};
-use crate::outcome::{Summary, summarize};
+use simlod::SimClock;
+use simlod::config::SimConfig;
+use simlod::lod::PopTally;
+use simlod::lod::{BudgetTally, Lod};
+use simlod::outcome::{Summary, summarize};
 
 /// Wall time of the frame's simulation ticks, and the frame rate, both smoothed.
 #[derive(Resource, Debug, Default)]
@@ -222,7 +222,7 @@ fn stats_text(
     // Only what the running policy reads: its radii, or its budget.
     let rules = &config.rules;
     let policy = config.scenario.level_policy;
-    let _ = write!(s, "level policy: {}", policy_name(policy));
+    let _ = write!(s, "level policy: {}", policy.name());
     let mut radii = Vec::new();
     if policy.uses_puck_radius() {
         radii.push(format!("puck {:.0} m", rules.influence.puck_radius_m));

@@ -30,12 +30,12 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use crate::SimStage;
-use crate::config::{SimConfig, Validate, Validator, load_file};
-use crate::creature::{Creature, DesiredVelocity, KindTable, PlanarState, PlayerControlled};
-use crate::headless::HeadlessSim;
-use crate::lod::{LevelPolicy, Lod};
-use crate::outcome::Summary;
+use simlod::SimStage;
+use simlod::config::{SimConfig, Validate, Validator, load_file};
+use simlod::creature::{Creature, DesiredVelocity, KindTable, PlanarState, PlayerControlled};
+use simlod::headless::HeadlessSim;
+use simlod::lod::{LevelPolicy, Lod};
+use simlod::outcome::Summary;
 
 /// How an experiment is run: flags of `simlod experiment`.
 #[derive(Clone, Debug)]
