@@ -7,12 +7,14 @@ use bevy::time::TimeUpdateStrategy;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::time::Instant;
 
-use crate::arena::PuckState;
 use crate::config::SimConfig;
-use crate::creature::{Creature, GaitPhase, PlanarState};
+use crate::contract::SimClock;
+use crate::contract::{GaitPhase, PlanarState};
+use crate::kind::Creature;
 use crate::lod::BudgetTally;
 use crate::outcome::{Summary, summarize};
-use crate::{SimClock, SimPlugin};
+use crate::plugin::SimPlugin;
+use crate::sense::PuckState;
 
 /// A headless simulation: `MinimalPlugins` plus the core, driven in fixed ticks.
 pub struct HeadlessSim {

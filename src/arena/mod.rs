@@ -4,42 +4,15 @@
 //! frictionless dynamic body, elastic against the walls. Rapier's solver loses a little
 //! energy at each bounce, so the puck is held at its configured speed, direction free.
 
+pub use crate::contract::{Ground, Puck, Wall};
+pub use crate::sense::{Court, PuckState};
+
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use rand::RngExt;
 
 use crate::config::SimConfig;
-use crate::{SimEntity, SimStage, SimStart, WorldRng};
-
-/// The court's inside, on the ground plane.
-#[derive(Resource, Clone, Copy, Debug)]
-pub struct Court {
-    /// Half the inside extents along world x and z.
-    pub half_extents: Vec2,
-}
-
-/// The giant puck (a rapier body).
-#[derive(Component, Debug)]
-pub struct Puck;
-
-/// The ground under the court (a fixed rapier collider).
-#[derive(Component, Debug)]
-pub struct Ground;
-
-/// A wall of the court (a fixed rapier collider).
-#[derive(Component, Debug)]
-pub struct Wall;
-
-/// The puck as every creature sees it this tick.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
-pub struct PuckState {
-    /// Centre on the ground plane (world x, z), metres.
-    pub position: Vec2,
-    /// Velocity on the ground plane, m/s.
-    pub velocity: Vec2,
-    /// The puck's own radius.
-    pub radius_m: f32,
-}
+use crate::contract::{SimEntity, SimStage, SimStart, StartStage, WorldRng};
 
 /// A launch direction away from the axes, so the puck does not bounce forever on one line.
 fn launch_direction(rng: &mut WorldRng) -> Vec2 {
@@ -48,8 +21,7 @@ fn launch_direction(rng: &mut WorldRng) -> Vec2 {
     Vec2::from_angle(angle)
 }
 
-/// Builds the court (ground and walls) and the puck at [`SimStart`]: order what dresses them after it.
-pub fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
+fn spawn_arena(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let arena = &config.arena;
     let half = arena.half_extents();
     commands.insert_resource(Court { half_extents: half });
@@ -150,6 +122,6 @@ fn drive_puck(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(SimStart, spawn_arena)
+    app.add_systems(SimStart, spawn_arena.in_set(StartStage::Arena))
         .add_systems(FixedUpdate, drive_puck.in_set(SimStage::Sense));
 }

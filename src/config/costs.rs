@@ -4,7 +4,7 @@
 //! corrected after a slow one.
 
 use super::{Validate, Validator};
-use crate::lod::Lod;
+use crate::contract::Lod;
 use serde::{Deserialize, Serialize};
 
 /// Predicted costs per kind and level.

@@ -1,11 +1,9 @@
 //! A creature definition: `assets/creatures/<kind>.ron`.
 
 use super::{Validate, Validator, number};
+use crate::contract::MAX_LEGS;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
-
-/// The most legs a kind may have (the pose keeps them in a fixed array: no allocation per tick).
-pub const MAX_LEGS: usize = 4;
 
 /// One kind of legged creature (the one-legged hopper, the biped, or a modder's own). Each
 /// number's comment gives the range it is checked against when loaded.

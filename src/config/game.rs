@@ -2,7 +2,7 @@
 //! Read by the game only; the simulation never sees it.
 
 use super::{Validate, Validator};
-use crate::lod::Lod;
+use crate::contract::Lod;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;

@@ -7,29 +7,31 @@
 mod arena;
 mod costs;
 mod creature;
+pub mod gait;
 mod game;
 mod loader;
 mod rules;
 mod scenario;
 mod validate;
 
+pub use crate::contract::MAX_LEGS;
 pub use arena::{ArenaConfig, PuckConfig};
 pub use costs::{CostModel, KindCosts, LevelCosts};
 pub use creature::{
-    BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, MAX_LEGS, RaibertConfig, RigidConfig, RigidJoints,
-    Stance, SteeringConfig,
+    BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, RaibertConfig, RigidConfig, RigidJoints, Stance,
+    SteeringConfig,
 };
 pub use game::{
     CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig, SceneColours, Srgb,
 };
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use rules::{BudgetRules, CameraRules, InfluenceRules, LevelRules};
-pub use scenario::{CreatureGroup, MAX_CREATURES, MAX_DURATION_S, Scenario};
+pub use scenario::{CreatureGroup, LevelPolicy, MAX_CREATURES, MAX_DURATION_S, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator, number};
 
 use bevy::prelude::*;
 
-use crate::gait::GaitTable;
+use crate::config::gait::GaitTable;
 use std::path::{Path, PathBuf};
 
 /// Everything one simulation run is built from: the scenario and the files it names.
@@ -368,6 +370,8 @@ pub fn plugin(app: &mut App) {
             .init_asset_loader::<RonAssetLoader<Scenario>>()
             .init_asset_loader::<RonAssetLoader<ArenaConfig>>()
             .init_asset_loader::<RonAssetLoader<CreatureDef>>()
-            .init_asset_loader::<RonAssetLoader<GameConfig>>();
+            .init_asset_loader::<RonAssetLoader<GameConfig>>()
+            .init_asset::<GaitTable>()
+            .init_asset_loader::<RonAssetLoader<GaitTable>>();
     }
 }

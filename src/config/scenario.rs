@@ -1,7 +1,7 @@
 //! A scenario: which creatures, how many, the seed and the level policy.
 
 use super::{Validate, Validator};
-use crate::lod::LevelPolicy;
+use crate::contract::Lod;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -102,5 +102,111 @@ impl Validate for Scenario {
             "creatures",
             format!("must hold between 1 and {MAX_CREATURES} creatures in all, got {total}"),
         );
+    }
+}
+
+/// How levels are chosen (a scenario's `level_policy`, or `--policy`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LevelPolicy {
+    /// Every creature at the point-mass level.
+    #[default]
+    AllPointMass,
+    /// Every creature at the hybrid level.
+    AllHybrid,
+    /// Every creature at the rigid level.
+    AllRigid,
+    /// Areas of influence (figure 5): rigid inside another's area, else hybrid.
+    Influence,
+    /// The camera rule (figure 6): rigid in view and near, hybrid in view, else point mass.
+    Camera,
+    /// The more detailed of the two.
+    Combined,
+    /// A frame budget: each creature's level chosen so that the predicted cost stays within
+    /// it, spent where a contact is soonest and the view nearest (beyond the paper).
+    Budget,
+}
+
+impl LevelPolicy {
+    /// Every policy, in the order the command line lists them.
+    pub const ALL: [LevelPolicy; 7] = [
+        LevelPolicy::AllPointMass,
+        LevelPolicy::AllHybrid,
+        LevelPolicy::AllRigid,
+        LevelPolicy::Influence,
+        LevelPolicy::Camera,
+        LevelPolicy::Combined,
+        LevelPolicy::Budget,
+    ];
+
+    /// The name used on the command line, in reports and in the game (`all-point-mass`).
+    pub fn name(self) -> &'static str {
+        match self {
+            LevelPolicy::AllPointMass => "all-point-mass",
+            LevelPolicy::AllHybrid => "all-hybrid",
+            LevelPolicy::AllRigid => "all-rigid",
+            LevelPolicy::Influence => "influence",
+            LevelPolicy::Camera => "camera",
+            LevelPolicy::Combined => "combined",
+            LevelPolicy::Budget => "budget",
+        }
+    }
+
+    /// What the policy does, in a line.
+    pub fn describe(self) -> &'static str {
+        match self {
+            LevelPolicy::AllPointMass => "Every creature at the point-mass level",
+            LevelPolicy::AllHybrid => "Every creature at the hybrid level",
+            LevelPolicy::AllRigid => "Every creature at the rigid level",
+            LevelPolicy::Influence => "Areas of influence (figure 5): rigid inside another's area, else hybrid",
+            LevelPolicy::Camera => {
+                "The camera rule (figure 6): rigid in view and near, hybrid in view, else point mass"
+            }
+            LevelPolicy::Combined => "The more detailed of the two",
+            LevelPolicy::Budget => {
+                "A frame budget: each creature's level chosen so that the predicted cost stays within it, spent where a contact is soonest and the view nearest (beyond the paper)"
+            }
+        }
+    }
+
+    /// Whether the policy reads the puck's radius of influence (figure 8).
+    pub fn uses_puck_radius(self) -> bool {
+        matches!(self, Self::Influence | Self::Combined)
+    }
+
+    /// Whether the policy reads the camera's radius of influence (figure 9).
+    pub fn uses_camera_radius(self) -> bool {
+        matches!(self, Self::Camera | Self::Combined)
+    }
+
+    /// Whether the policy reads the frame budget.
+    pub fn uses_frame_budget(self) -> bool {
+        self == Self::Budget
+    }
+
+    /// Whether levels change during a game under this policy.
+    pub fn is_dynamic(self) -> bool {
+        matches!(
+            self,
+            LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined | LevelPolicy::Budget
+        )
+    }
+
+    /// The level a creature starts at, given the levels its kind has models for: the policy's
+    /// level (hybrid for the rules, which then move it; the cheapest for the budget, which
+    /// then spends it), or the most detailed one below it that the kind has.
+    pub fn initial_level(self, available: &[Lod]) -> Lod {
+        let wanted = match self {
+            LevelPolicy::AllPointMass | LevelPolicy::Budget => Lod::PointMass,
+            LevelPolicy::AllHybrid | LevelPolicy::Influence | LevelPolicy::Camera | LevelPolicy::Combined => {
+                Lod::Hybrid
+            }
+            LevelPolicy::AllRigid => Lod::Rigid,
+        };
+        available
+            .iter()
+            .copied()
+            .filter(|&l| l <= wanted)
+            .max()
+            .unwrap_or(Lod::PointMass)
     }
 }

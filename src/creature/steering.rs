@@ -9,10 +9,10 @@
 use bevy::prelude::*;
 
 use super::{Creature, DesiredVelocity, KindParams, KindTable, PlanarState, PlayerControlled};
-use crate::arena::{Court, PuckState};
 use crate::config::SimConfig;
+use crate::contract::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
 use crate::sense::NeighbourGrid;
-use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
+use crate::sense::{Court, PuckState};
 
 /// A deterministic random number in `[-1, 1]` for one creature at one decision: a
 /// counter-based stream keyed by the world seed, so parallel steering stays reproducible.

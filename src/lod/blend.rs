@@ -16,10 +16,11 @@ use bevy::prelude::*;
 use serde::Serialize;
 
 use super::Lod;
-use crate::config::MAX_LEGS;
-use crate::creature::{Creature, KindTable, PlanarState};
-use crate::gait::{GaitPose, LegPose};
-use crate::{SimClock, SimStage, SimStart};
+use crate::contract::MAX_LEGS;
+use crate::contract::PlanarState;
+use crate::contract::{GaitPose, LegPose};
+use crate::contract::{SimClock, SimStage, SimStart};
+use crate::kind::{Creature, KindTable};
 
 /// Scalars of a drawn pose that a blend offsets: body position (3), body rotation (3, as a
 /// scaled axis), then each leg's length and two angles.
@@ -431,12 +432,7 @@ fn reset_pop_tally(mut tally: ResMut<PopTally>) {
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<PopTally>()
         .add_systems(SimStart, reset_pop_tally)
-        .add_systems(
-            FixedUpdate,
-            blend_and_measure
-                .in_set(SimStage::Outcome)
-                .before(crate::outcome::advance_clock),
-        );
+        .add_systems(FixedUpdate, blend_and_measure.in_set(SimStage::Outcome));
 }
 
 #[cfg(test)]

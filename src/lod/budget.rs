@@ -25,12 +25,13 @@ use std::cell::Cell;
 
 use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start_at_selected_levels};
 use super::{LevelPolicy, Lod};
-use crate::arena::{Court, PuckState};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
-use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState, starting_gait};
-use crate::gait::GaitPose;
+use crate::contract::GaitPose;
+use crate::contract::{GaitPhase, PlanarState};
+use crate::contract::{SimStage, SimStart, StartStage};
+use crate::kind::{Creature, KindParams, KindTable, starting_gait};
 use crate::sense::NeighbourGrid;
-use crate::{SimStage, SimStart};
+use crate::sense::{Court, PuckState};
 
 /// One creature as the knapsack sees it.
 #[derive(Clone, Debug)]
@@ -541,7 +542,12 @@ fn start_by_budget(
 
 pub(super) fn plugin(app: &mut App) {
     app.init_resource::<BudgetTally>()
-        .add_systems(SimStart, start_by_budget.after(start_at_selected_levels))
+        .add_systems(
+            SimStart,
+            start_by_budget
+                .after(start_at_selected_levels)
+                .in_set(StartStage::Levels),
+        )
         .add_systems(
             FixedUpdate,
             choose_by_budget

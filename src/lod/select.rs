@@ -25,12 +25,13 @@ use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
 
 use super::{LevelPolicy, Lod};
-use crate::arena::{Court, PuckState};
 use crate::config::{LevelRules, SimConfig};
-use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState, PlayerControlled, starting_gait};
-use crate::gait::GaitPose;
+use crate::contract::GaitPose;
+use crate::contract::{GaitPhase, PlanarState, PlayerControlled};
+use crate::contract::{SimClock, SimStage, SimStart, StartStage};
+use crate::kind::{Creature, KindParams, KindTable, starting_gait};
 use crate::sense::NeighbourGrid;
-use crate::{SimClock, SimStage, SimStart};
+use crate::sense::{Court, PuckState};
 
 /// The level the rules want for a creature, and when it last switched.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
@@ -412,7 +413,7 @@ pub(super) fn plugin(app: &mut App) {
                 start_at_selected_levels,
             )
                 .chain()
-                .after(crate::sense::index_creatures),
+                .in_set(StartStage::Levels),
         )
         .add_systems(
             FixedUpdate,

@@ -14,10 +14,11 @@ use bevy::prelude::*;
 use super::blend::{Drawn, DrawnBefore, SwitchBlend, SwitchProbe};
 use super::select::{LevelChoice, SimCamera, levels_may_change};
 use super::{LevelPolicy, Lod};
-use crate::creature::{Creature, GaitPhase, KindTable, PlanarState};
-use crate::gait::GaitPose;
-use crate::outcome::{CollisionRecord, Counts, SwitchCounts};
-use crate::{SimClock, SimStage, SimStart};
+use crate::contract::GaitPose;
+use crate::contract::{CollisionRecord, Counts, SwitchCounts};
+use crate::contract::{GaitPhase, PlanarState};
+use crate::contract::{SimClock, SimStage, SimStart};
+use crate::kind::{Creature, KindTable};
 
 /// A creature changed level.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]

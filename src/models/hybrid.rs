@@ -4,8 +4,9 @@
 //! hop cycle advances at the table's hop period for the current speed ("the running
 //! frequency is nearly independent of forward velocity").
 
-use crate::creature::GaitPhase;
-use crate::gait::{GaitPose, GaitTable};
+use crate::config::gait::GaitTable;
+use crate::contract::GaitPhase;
+use crate::contract::GaitPose;
 
 /// The body and legs at `speed` and the gait's place in its stride: a function of the two
 /// alone, so it is worked out only for the ticks something reads it.

@@ -7,10 +7,12 @@ use bevy::prelude::*;
 
 use super::hybrid;
 use crate::config::SimConfig;
-use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState};
-use crate::gait::{GaitPose, GaitTable};
-use crate::lod::{AtPointMass, AtRigid, Lod};
-use crate::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
+use crate::config::gait::GaitTable;
+use crate::contract::GaitPose;
+use crate::contract::{AtPointMass, AtRigid, Lod};
+use crate::contract::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
+use crate::contract::{DesiredVelocity, GaitPhase, PlanarState};
+use crate::kind::{Creature, KindParams, KindTable};
 
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
@@ -238,7 +240,8 @@ fn step_point_masses(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_observer(enter_point_mass)
+    app.register_required_components::<Creature, FrameStep>()
+        .add_observer(enter_point_mass)
         .add_systems(FixedUpdate, step_point_masses.in_set(SimStage::Step));
 }
 
@@ -246,7 +249,7 @@ pub(super) fn plugin(app: &mut App) {
 pub(crate) mod tests {
     use super::*;
     use crate::config::SteeringConfig;
-    use crate::creature::VirtualLegs;
+    use crate::kind::VirtualLegs;
 
     /// A hopper-sized kind: 0.3 m, 10 kg, 3 m/s, 2 m/s^2.
     pub(crate) fn kind() -> KindParams {

@@ -11,90 +11,26 @@
 //! before the next decision (chosen at each decision); contacts between creatures at each
 //! steering decision, through the spatial index.
 
-mod counts;
-
-pub use counts::{Counts, Key, SwitchCounts};
+pub use crate::contract::{CollisionRecord, Counts, FallQueue, Key, Obstacle, SwitchCounts};
 
 use bevy::prelude::*;
 use bevy::utils::Parallel;
 use serde::Serialize;
-use std::sync::Mutex;
 
-use crate::arena::{Court, PuckState};
+use crate::config::LevelPolicy;
 use crate::config::SimConfig;
-use crate::creature::{
-    Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState, PlayerControlled, SerialCounter,
-    creature_bundle, find_free_spot,
-};
-use crate::gait::GaitPose;
+use crate::contract::GaitPose;
+use crate::contract::{AtRigid, Lod};
+use crate::contract::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
+use crate::contract::{DesiredVelocity, GaitPhase, PlanarState, PlayerControlled};
+use crate::creature::{SerialCounter, creature_bundle, find_free_spot};
+use crate::kind::{Creature, KindParams, KindTable};
 use crate::lod::{
-    AtRigid, BudgetSummary, BudgetTally, LevelChoice, LevelPolicy, LevelSwitched, Lod, PopSummary, PopTally,
-    SwitchProbe, SwitchTally,
+    BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SwitchProbe, SwitchTally,
 };
 use crate::models::point_mass::{FrameStep, FrameStepping, PlanarStepper};
 use crate::sense::NeighbourGrid;
-use crate::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
-
-/// What a creature can collide with.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Obstacle {
-    /// The giant puck.
-    Puck = 0,
-    /// A wall of the court.
-    Wall = 1,
-    /// Another creature.
-    Creature = 2,
-}
-
-impl Obstacle {
-    /// Every obstacle, in the summary's order.
-    pub const ALL: [Obstacle; 3] = [Obstacle::Puck, Obstacle::Wall, Obstacle::Creature];
-
-    /// The name in summaries.
-    pub fn name(self) -> &'static str {
-        match self {
-            Obstacle::Puck => "puck",
-            Obstacle::Wall => "wall",
-            Obstacle::Creature => "creature",
-        }
-    }
-}
-
-/// One creature's collisions. A collision is the start of a contact.
-#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
-pub struct CollisionRecord {
-    /// In contact with each [`Obstacle`] at the last check.
-    pub touching: [bool; 3],
-    /// Collisions with each [`Obstacle`].
-    pub count: [u32; 3],
-}
-
-impl CollisionRecord {
-    /// The paper's outcome measure: did it collide with the puck or a wall?
-    pub fn hit_puck_or_wall(&self) -> bool {
-        self.count[Obstacle::Puck as usize] + self.count[Obstacle::Wall as usize] > 0
-    }
-
-    /// Notes whether the creature touches `obstacle` now; a new contact is a collision.
-    pub(crate) fn note(&mut self, obstacle: Obstacle, touching: bool) {
-        let i = obstacle as usize;
-        if touching && !self.touching[i] {
-            self.count[i] += 1;
-        }
-        self.touching[i] = touching;
-    }
-}
-
-/// Creatures that fell this tick; filled in parallel, emptied in serial order.
-#[derive(Resource, Default)]
-pub struct FallQueue(Mutex<Vec<(u32, Entity)>>);
-
-impl FallQueue {
-    /// Marks a creature (by serial and entity) as fallen this tick.
-    pub fn push(&self, serial: u32, entity: Entity) {
-        self.0.lock().unwrap_or_else(|p| p.into_inner()).push((serial, entity));
-    }
-}
+use crate::sense::{Court, PuckState};
 
 /// Creatures' collision records added up.
 #[derive(Clone, Copy, Debug, Default)]
@@ -423,7 +359,7 @@ fn respawn_fallen(
     mut serials: ResMut<SerialCounter>,
     creatures: Query<(&Creature, &Lod, &CollisionRecord, &LevelChoice, &GaitPhase)>,
 ) {
-    let mut fallen = std::mem::take(&mut *falls.0.lock().unwrap_or_else(|p| p.into_inner()));
+    let mut fallen = falls.take();
     if fallen.is_empty() {
         return;
     }
@@ -587,7 +523,10 @@ pub(super) fn plugin(app: &mut App) {
         .add_systems(FixedUpdate, detect_collisions.in_set(SimStage::Observe))
         .add_systems(
             FixedUpdate,
-            (respawn_fallen, advance_clock).chain().in_set(SimStage::Outcome),
+            (
+                respawn_fallen.in_set(SimStage::Outcome),
+                advance_clock.in_set(SimStage::Clock),
+            ),
         );
 }
 

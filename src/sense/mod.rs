@@ -4,8 +4,27 @@
 use bevy::prelude::*;
 
 use crate::config::SimConfig;
-use crate::creature::{Creature, KindTable, PlanarState};
-use crate::{SimClock, SimStage, SimStart};
+use crate::contract::PlanarState;
+use crate::contract::{SimClock, SimStage, SimStart, StartStage};
+use crate::kind::{Creature, KindTable};
+
+/// The court's inside, on the ground plane.
+#[derive(Resource, Clone, Copy, Debug)]
+pub struct Court {
+    /// Half the inside extents along world x and z.
+    pub half_extents: Vec2,
+}
+
+/// The puck as every creature sees it this tick.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct PuckState {
+    /// Centre on the ground plane (world x, z), metres.
+    pub position: Vec2,
+    /// Velocity on the ground plane, m/s.
+    pub velocity: Vec2,
+    /// The puck's own radius.
+    pub radius_m: f32,
+}
 
 /// What a creature knows of a neighbour: a snapshot taken when the index was built.
 #[derive(Clone, Copy, Debug)]
@@ -242,13 +261,8 @@ pub(crate) fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
 
 pub(super) fn plugin(app: &mut App) {
     // The index of the creatures as placed, for the rules that give each its first level.
-    app.add_systems(
-        SimStart,
-        (size_grid, index_creatures)
-            .chain()
-            .after(crate::creature::spawn_creatures),
-    )
-    .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
+    app.add_systems(SimStart, (size_grid, index_creatures).chain().in_set(StartStage::Index))
+        .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
 }
 
 #[cfg(test)]

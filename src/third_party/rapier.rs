@@ -4,8 +4,8 @@
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
-use crate::SimStart;
 use crate::config::SimConfig;
+use crate::contract::SimStart;
 
 /// Rapier steps once per simulation tick of `dt` seconds (it keeps its own copy of the step).
 pub fn set_timestep(world: &mut World, dt: f32) {

@@ -12,6 +12,7 @@ mod fuzz;
 mod gait;
 mod game;
 mod kinds;
+mod layers;
 mod outcome;
 mod player;
 mod pops;

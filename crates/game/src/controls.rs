@@ -204,7 +204,7 @@ mod tests {
     use std::path::Path;
 
     fn app_with_keys(policy: LevelPolicy) -> App {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets");
+        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
         let mut config = SimConfig::load(&root.join("scenarios/default.ron"), &root).unwrap();
         config.scenario.level_policy = policy;
         let looks = load_file(&root.join(crate::GAME_FILE)).unwrap();

@@ -11,7 +11,7 @@ use super::GameSettings;
 use simlod::arena::{Puck, PuckState, Wall};
 use simlod::config::{SimConfig, Srgb};
 use simlod::lod::Lod;
-use simlod::{SimEntity, SimStart};
+use simlod::{SimEntity, SimStart, StartStage};
 
 /// A colour from `game.ron` (sRGB, each channel 0 to 1) as Bevy's.
 pub fn srgb(c: Srgb) -> Color {
@@ -247,7 +247,7 @@ pub(super) fn plugin(app: &mut App) {
     let palette = make_palette(&mut app.world_mut().resource_mut::<Assets<StandardMaterial>>());
     app.insert_resource(palette)
         .insert_resource(ColourByLevel(true))
-        .add_systems(SimStart, dress_court.after(simlod::arena::spawn_arena))
+        .add_systems(SimStart, dress_court.after(StartStage::Arena))
         .add_systems(Startup, (light_the_court, spawn_puck_path))
         .add_systems(Update, (recolour, aim_the_sun, point_puck_path));
 }

@@ -22,12 +22,14 @@ use bevy_rapier3d::prelude::*;
 use std::f32::consts::PI;
 
 use super::{RigidBodies, RigidPart};
-use crate::SimClock;
-use crate::config::{LegConfig, MAX_LEGS, RigidConfig};
-use crate::creature::{Creature, DesiredVelocity, GaitPhase, KindParams, KindTable, PlanarState, VirtualLegs};
-use crate::gait::GaitPose;
-use crate::lod::AtRigid;
-use crate::outcome::FallQueue;
+use crate::config::{LegConfig, RigidConfig};
+use crate::contract::AtRigid;
+use crate::contract::FallQueue;
+use crate::contract::GaitPose;
+use crate::contract::MAX_LEGS;
+use crate::contract::SimClock;
+use crate::contract::{DesiredVelocity, GaitPhase, PlanarState};
+use crate::kind::{Creature, KindParams, KindTable, VirtualLegs};
 
 /// Foot centre this far above its resting height still counts as on the ground.
 pub(super) const FOOT_CONTACT_TOLERANCE_M: f32 = 0.004;

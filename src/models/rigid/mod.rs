@@ -17,13 +17,15 @@ pub use controller::{Raibert, Shove, StancePhase};
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
-use crate::arena::{Ground, Puck, Wall};
-use crate::config::{LegConfig, MAX_LEGS, RigidConfig, RigidJoints};
-use crate::creature::{Creature, GaitPhase, KindParams, KindTable, PlanarState};
-use crate::gait::{GaitPose, LegPose};
-use crate::lod::AtRigid;
-use crate::outcome::{CollisionRecord, FallQueue, Obstacle};
-use crate::{SimClock, SimStage};
+use crate::config::{LegConfig, RigidConfig, RigidJoints};
+use crate::contract::AtRigid;
+use crate::contract::MAX_LEGS;
+use crate::contract::{CollisionRecord, FallQueue, Obstacle};
+use crate::contract::{GaitPhase, PlanarState};
+use crate::contract::{GaitPose, LegPose};
+use crate::contract::{Ground, Puck, Wall};
+use crate::contract::{SimClock, SimStage};
+use crate::kind::{Creature, KindParams, KindTable};
 
 /// The rapier bodies of one leg.
 #[derive(Clone, Copy, Debug)]

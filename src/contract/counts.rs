@@ -6,7 +6,7 @@ use std::marker::PhantomData;
 use std::ops::{Index, IndexMut};
 
 use super::Obstacle;
-use crate::lod::Lod;
+use crate::contract::Lod;
 
 /// A key of a fixed set of three, with the name the summary prints for it.
 pub trait Key: Copy + 'static {

@@ -1,0 +1,182 @@
+//! The `run` command: a scenario simulated without a window, and its summary.
+
+use clap::Args;
+use std::path::PathBuf;
+
+use crate::scenario::*;
+use simlod::config::{MAX_DURATION_S, SimConfig};
+use simlod::headless;
+use simlod::outcome::{Counts, Key, Summary};
+
+#[derive(Args)]
+pub(crate) struct RunArgs {
+    #[command(flatten)]
+    pub(crate) scenario: ScenarioArgs,
+    /// Simulated seconds (default: the scenario's duration).
+    #[arg(long, allow_negative_numbers = true, value_parser = positive_seconds)]
+    pub(crate) seconds: Option<f64>,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+impl RunArgs {
+    /// Simulates the scenario and prints what happened. A flag the run's policy never reads is
+    /// refused rather than ignored.
+    pub(crate) fn run(&self) -> Result<(), String> {
+        let config = self.scenario.load()?;
+        let policy = config.scenario.level_policy;
+        let unread = [
+            (
+                "--puck-radius",
+                self.scenario.puck_radius.is_some() && !policy.uses_puck_radius(),
+            ),
+            (
+                "--camera-radius",
+                self.scenario.camera_radius.is_some() && !policy.uses_camera_radius(),
+            ),
+            (
+                "--frame-budget",
+                self.scenario.frame_budget.is_some() && !policy.uses_frame_budget(),
+            ),
+        ];
+        if let Some((flag, _)) = unread.iter().find(|(_, unread)| *unread) {
+            return Err(format!(
+                "{flag} does not apply to the {} policy, which never reads it (choose a policy that does with --policy)",
+                policy.name()
+            ));
+        }
+        let seconds = self.seconds.unwrap_or(f64::from(config.scenario.duration_s));
+        let summary = headless::run(config.clone(), seconds);
+        let ran = self.scenario.what_ran(&config);
+        if self.json {
+            let mut json = serde_json::to_value(&summary).expect("a summary serialises");
+            json["policy"] = ran.policy.into();
+            json["rules"] = ran.rules.display().to_string().into();
+            json["cost_model"] = ran.cost_model.display().to_string().into();
+            println!("{json}");
+        } else {
+            print_summary(self, &summary, &config, &ran);
+        }
+        Ok(())
+    }
+}
+
+/// What a run ran under: its level policy, as the command line names it, and the files of its
+/// level rules and cost model.
+pub(crate) struct WhatRan {
+    pub(crate) policy: String,
+    pub(crate) rules: PathBuf,
+    pub(crate) cost_model: PathBuf,
+}
+
+pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if v.is_finite() && v > 0.0 && v <= f64::from(MAX_DURATION_S) {
+        Ok(v)
+    } else {
+        Err(format!(
+            "must be more than 0 and at most {MAX_DURATION_S} seconds, got {v}"
+        ))
+    }
+}
+
+pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran: &WhatRan) {
+    pub(crate) fn join<K: Key, T: std::fmt::Display + Copy>(counts: &Counts<K, T>) -> String {
+        counts
+            .iter()
+            .map(|(k, v)| format!("{} {v}", k.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+    println!(
+        "simlod run: {}, seed {}, {} creatures",
+        args.scenario.scenario_file().display(),
+        s.seed,
+        s.creatures
+    );
+    println!(
+        "level policy {} (rules {}, cost model {})",
+        ran.policy,
+        ran.rules.display(),
+        ran.cost_model.display()
+    );
+    println!(
+        "simulated {:.2} s in {:.3} s of wall time ({:.1}x real time); {} Hz ticks, {} Hz steering",
+        s.sim_seconds, s.wall_seconds, s.realtime_factor, config.scenario.tick_hz, config.scenario.decision_hz
+    );
+    println!("collisions: {}", join(&s.collisions));
+    println!(
+        "creatures that collided with the puck or a wall: {} (by what they hit, one creature counted under each it hit: {})",
+        s.creatures_collided,
+        join(&s.creatures_collided_with)
+    );
+    println!(
+        "falls: {} ({} within a step of going rigid), respawns: {}",
+        s.falls, s.falls_after_switch, s.respawns
+    );
+    println!("creatures per level at the end: {}", join(&s.levels));
+    let mean: Vec<String> = s
+        .levels_mean
+        .iter()
+        .map(|(k, v)| format!("{} {v:.1} (peak {})", k.name(), s.levels_peak[k]))
+        .collect();
+    println!("creatures per level on average: {}", mean.join(", "));
+    println!(
+        "frame as the cost model predicts it from the levels simulated: {:.2} ms on average, {:.2} ms at the slowest",
+        s.predicted_frame.mean_ms, s.predicted_frame.slowest_ms
+    );
+    let switches: Vec<String> = s
+        .switches
+        .directions()
+        .map(|(from, to, n)| format!("{}->{} {n}", from.name(), to.name()))
+        .chain([format!("total {}", s.switches.total())])
+        .collect();
+    println!("level switches: {}", switches.join(", "));
+    if let Some(b) = &s.budget {
+        let chosen = if b.decisions_over_budget == 0 {
+            "within it at every decision".to_owned()
+        } else {
+            format!(
+                "over it at {} of {} decisions (even the cheapest levels did not fit)",
+                b.decisions_over_budget, b.decisions
+            )
+        };
+        let adaptive = if b.adaptive {
+            format!(
+                " (adaptive, not reproducible: the cost model corrected x {:.2} at the end)",
+                b.correction
+            )
+        } else {
+            String::new()
+        };
+        // The wall clock, read outside the simulation: what the prediction is measured against.
+        let measured_ms = s.wall_seconds * 1e3 / b.decisions.max(1) as f64;
+        let kept = if measured_ms > f64::from(b.frame_budget_ms) {
+            format!(
+                "{:.0} % over the budget",
+                (measured_ms / f64::from(b.frame_budget_ms).max(1e-9) - 1.0) * 100.0
+            )
+        } else {
+            "within the budget".to_owned()
+        };
+        println!(
+            "frame budget {} ms of simulation per 1/30 s: as the policy chose, predicted {:.3} ms on average and {:.3} ms at most, {chosen}{adaptive}; measured {measured_ms:.3} ms of wall time on average, {kept}",
+            b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max
+        );
+    }
+    for p in &s.pops {
+        println!(
+            "  pops {}->{}{}: as drawn {:.2} cm, {:.2} deg, {:.3} m/s; models alone {:.1} cm, {:.1} deg (largest of {})",
+            p.from,
+            p.to,
+            if p.forced { " (forced)" } else { "" },
+            p.metres.max * 100.0,
+            p.degrees.max,
+            p.velocity_m_per_s.max,
+            p.model_metres.max * 100.0,
+            p.model_degrees.max,
+            p.count
+        );
+    }
+}
