@@ -23,7 +23,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let ticks_per_frame = config.scenario.ticks_per_decision();
 
     let mut app = App::new();
-    app.add_plugins(MinimalPlugins).add_plugins(SimPlugin { config });
+    app.add_plugins(MinimalPlugins).add_plugins(SimPlugin::new(config));
     app.finish();
     app.cleanup();
     // The first update builds the world (`Startup`); every later one runs one frame's fixed

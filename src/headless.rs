@@ -32,7 +32,7 @@ impl HeadlessSim {
         app.add_plugins(MinimalPlugins.set(TaskPoolPlugin {
             task_pool_options: compute_on_every_core(),
         }))
-        .add_plugins(SimPlugin { config });
+        .add_plugins(SimPlugin::new(config));
         app.finish();
         app.cleanup();
         // Headless, every schedule is small: one thread runs them without wake-ups. Loops over

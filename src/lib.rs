@@ -29,7 +29,9 @@
 //! - The level policy and rules are fields of the [`config::SimConfig`] resource, read at
 //!   every steering decision: [`lod::LevelPolicy`], [`config::LevelRules`].
 //!
-//! The `examples/` folder has four runnable programs, and `docs/guide/` the user guide.
+//! [`prelude`] holds what a host app usually needs. The `examples/` folder has runnable
+//! programs (`host_game.rs` adds simlod to an app that has rapier and bodies of its own), and
+//! `docs/guide/` the user guide; its architecture page draws the layers of this crate.
 
 #![warn(missing_docs)]
 
@@ -64,3 +66,17 @@ pub use contract::{
     DENSE, PARALLEL_MIN_CREATURES, SimClock, SimEntity, SimStage, SimStart, StartStage, WorldRng, chunk_len, run_chunks,
 };
 pub use plugin::{SimPlugin, start_over};
+
+/// What a game or tool that adds simlod to its app usually needs, in one import:
+/// `use simlod::prelude::*;`.
+pub mod prelude {
+    pub use crate::config::{LevelPolicy, SimConfig};
+    pub use crate::contract::{
+        AtHybrid, AtPointMass, AtRigid, CollisionRecord, DesiredVelocity, GaitPhase, GaitPose, Lod, Obstacle,
+        PlanarState, PlayerControlled, SimClock, SimEntity, SimStage, SimStart, StartStage,
+    };
+    pub use crate::headless::{HeadlessSim, run_ticks_per_update};
+    pub use crate::kind::{Creature, KindTable};
+    pub use crate::outcome::{Summary, summarize};
+    pub use crate::plugin::{SimPlugin, start_over};
+}

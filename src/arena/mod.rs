@@ -12,6 +12,7 @@ use bevy_rapier3d::prelude::*;
 use rand::RngExt;
 
 use crate::config::SimConfig;
+use crate::contract::SimClock;
 use crate::contract::{SimEntity, SimStage, SimStart, StartStage, WorldRng};
 
 /// A launch direction away from the axes, so the puck does not bounce forever on one line.
@@ -122,6 +123,7 @@ fn drive_puck(
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.add_systems(SimStart, spawn_arena.in_set(StartStage::Arena))
-        .add_systems(FixedUpdate, drive_puck.in_set(SimStage::Sense));
+        .add_systems(schedule, drive_puck.in_set(SimStage::Sense));
 }

@@ -8,7 +8,7 @@ mod level;
 mod motion;
 mod pose;
 
-use bevy::ecs::schedule::ScheduleLabel;
+use bevy::ecs::schedule::{InternedScheduleLabel, ScheduleLabel};
 use bevy::prelude::*;
 use rand::rngs::StdRng;
 
@@ -94,9 +94,18 @@ pub struct SimClock {
     pub tick_hz: u32,
     /// Ticks per steering decision (`tick_hz / decision_hz`).
     pub ticks_per_decision: u32,
+    /// The schedule the ticks run in (`FixedUpdate` unless the host chose another).
+    pub schedule: InternedScheduleLabel,
 }
 
 impl SimClock {
+    /// The schedule a layer adds its tick's systems to: the clock's, else `FixedUpdate`.
+    pub fn schedule_of(app: &App) -> InternedScheduleLabel {
+        app.world()
+            .get_resource::<SimClock>()
+            .map_or_else(|| FixedUpdate.intern(), |clock| clock.schedule)
+    }
+
     /// Steering and the spatial index run on these ticks only (the decision rate).
     pub fn is_decision_tick(&self) -> bool {
         self.tick.is_multiple_of(u64::from(self.ticks_per_decision))

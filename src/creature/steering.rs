@@ -149,7 +149,8 @@ fn steer(
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_systems(FixedUpdate, steer.in_set(SimStage::Steer));
+    let schedule = SimClock::schedule_of(app);
+    app.add_systems(schedule, steer.in_set(SimStage::Steer));
 }
 
 #[cfg(test)]

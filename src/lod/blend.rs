@@ -430,9 +430,10 @@ fn reset_pop_tally(mut tally: ResMut<PopTally>) {
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.init_resource::<PopTally>()
         .add_systems(SimStart, reset_pop_tally)
-        .add_systems(FixedUpdate, blend_and_measure.in_set(SimStage::Outcome));
+        .add_systems(schedule, blend_and_measure.in_set(SimStage::Outcome));
 }
 
 #[cfg(test)]

@@ -18,6 +18,8 @@
 //! for the flight window (`switch.rs`). No clock is read: the same files give the same run,
 //! unless the adaptive mode (`adaptive_frames` above 0) corrects the cost model by measured
 //! frame times, which the game and the headless runner write from outside the simulation.
+//!
+//! Over 600 lines with its unit tests, which sit beside the allocation they check.
 
 use bevy::prelude::*;
 use serde::Serialize;
@@ -27,6 +29,7 @@ use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start
 use super::{LevelPolicy, Lod};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::contract::GaitPose;
+use crate::contract::SimClock;
 use crate::contract::{GaitPhase, PlanarState};
 use crate::contract::{SimStage, SimStart, StartStage};
 use crate::kind::{Creature, KindParams, KindTable, starting_gait};
@@ -541,6 +544,7 @@ fn start_by_budget(
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.init_resource::<BudgetTally>()
         .add_systems(
             SimStart,
@@ -549,7 +553,7 @@ pub(super) fn plugin(app: &mut App) {
                 .in_set(StartStage::Levels),
         )
         .add_systems(
-            FixedUpdate,
+            schedule,
             choose_by_budget
                 .in_set(SimStage::SelectLod)
                 .after(select_levels)

@@ -402,6 +402,7 @@ pub(super) fn start_at_selected_levels(
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.init_resource::<SimCamera>()
         .init_resource::<LevelsSettled>()
         .add_systems(
@@ -416,7 +417,7 @@ pub(super) fn plugin(app: &mut App) {
                 .in_set(StartStage::Levels),
         )
         .add_systems(
-            FixedUpdate,
+            schedule,
             (
                 unsettle_levels.run_if(resource_changed::<SimConfig>),
                 (

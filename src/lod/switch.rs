@@ -170,12 +170,13 @@ fn reset_switch_tally(mut tally: ResMut<SwitchTally>) {
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.init_resource::<SwitchTally>()
         .add_message::<LevelSwitched>()
         .add_systems(SimStart, reset_switch_tally)
         .add_systems(
-            FixedUpdate,
+            schedule,
             switch_levels.in_set(SimStage::Switch).run_if(levels_may_change),
         )
-        .add_systems(FixedUpdate, count_levels.in_set(SimStage::Observe));
+        .add_systems(schedule, count_levels.in_set(SimStage::Observe));
 }

@@ -240,9 +240,10 @@ fn step_point_masses(
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.register_required_components::<Creature, FrameStep>()
         .add_observer(enter_point_mass)
-        .add_systems(FixedUpdate, step_point_masses.in_set(SimStage::Step));
+        .add_systems(schedule, step_point_masses.in_set(SimStage::Step));
 }
 
 #[cfg(test)]

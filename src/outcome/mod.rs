@@ -517,12 +517,13 @@ fn reset_tally(mut tally: ResMut<Tally>) {
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.init_resource::<FallQueue>()
         .init_resource::<Tally>()
         .add_systems(SimStart, reset_tally)
-        .add_systems(FixedUpdate, detect_collisions.in_set(SimStage::Observe))
+        .add_systems(schedule, detect_collisions.in_set(SimStage::Observe))
         .add_systems(
-            FixedUpdate,
+            schedule,
             (
                 respawn_fallen.in_set(SimStage::Outcome),
                 advance_clock.in_set(SimStage::Clock),

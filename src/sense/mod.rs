@@ -260,9 +260,10 @@ pub(crate) fn size_grid(mut commands: Commands, config: Res<SimConfig>) {
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     // The index of the creatures as placed, for the rules that give each its first level.
     app.add_systems(SimStart, (size_grid, index_creatures).chain().in_set(StartStage::Index))
-        .add_systems(FixedUpdate, index_creatures.in_set(SimStage::Sense));
+        .add_systems(schedule, index_creatures.in_set(SimStage::Sense));
 }
 
 #[cfg(test)]

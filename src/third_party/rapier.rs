@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
 use crate::config::SimConfig;
-use crate::contract::SimStart;
+use crate::contract::{SimClock, SimStart};
 
 /// Rapier steps once per simulation tick of `dt` seconds (it keeps its own copy of the step).
 pub fn set_timestep(world: &mut World, dt: f32) {
@@ -45,6 +45,10 @@ fn set_integration_parameters(config: Res<SimConfig>, mut contexts: Query<&mut R
 }
 
 pub(super) fn plugin(app: &mut App) {
-    app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_fixed_schedule())
-        .add_systems(SimStart, set_integration_parameters);
+    // The host's rapier, where it has one.
+    if !app.is_plugin_added::<RapierPhysicsPlugin<NoUserData>>() {
+        let schedule = SimClock::schedule_of(app);
+        app.add_plugins(RapierPhysicsPlugin::<NoUserData>::default().in_schedule(schedule));
+    }
+    app.add_systems(SimStart, set_integration_parameters);
 }

@@ -76,6 +76,11 @@ fn step_response_refuses_a_broken_experiment_file() {
     )
     .unwrap();
     let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
+    assert!(
+        matches!(err, simlod_lab::LabError::Config(_)),
+        "a bad file is a config error: {err:?}"
+    );
+    let err = err.to_string();
     assert!(err.contains("`duration_s`") && err.contains("`steps`"), "{err}");
 }
 
@@ -116,7 +121,7 @@ fn quick(out: &Path) -> Options {
     }
 }
 
-fn run(name: &str, options: &Options) -> Result<String, String> {
+fn run(name: &str, options: &Options) -> Result<String, simlod_lab::LabError> {
     experiments::run_named(
         name,
         &default_config(),
@@ -308,7 +313,9 @@ fn fig10_does_not_depend_on_jobs_and_shards_merged_equal_one_run() {
     });
     assert_eq!(merged[1..], from_parts[..]);
     // Overlapping parts are refused.
-    let err = experiments::fig10::merge(&[parts[0].clone(), parts[0].clone()], &dir.join("bad")).unwrap_err();
+    let err = experiments::fig10::merge(&[parts[0].clone(), parts[0].clone()], &dir.join("bad"))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("overlap"), "{err}");
 }
 
@@ -365,14 +372,18 @@ fn a_resume_refuses_rows_made_with_other_settings() {
     fig10(&fig10_file(&dir, "0.0", 1.0, 2), &options);
     // The same radii, trials and seeds, but trials of another length: none of its rows count.
     let longer = fig10_file(&dir, "0.0", 2.0, 2);
-    let err = experiments::fig10::run(&default_config(), &longer, &options).unwrap_err();
+    let err = experiments::fig10::run(&default_config(), &longer, &options)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("fig10.csv") && err.contains("other settings"), "{err}");
     // Another scenario is another plan too.
     let mut fewer = default_config();
     fewer.scenario.creatures[0].count -= 1;
     let same = dir.join("fig10.ron");
     fig10_file(&dir, "0.0", 1.0, 2);
-    let err = experiments::fig10::run(&fewer, &same, &options).unwrap_err();
+    let err = experiments::fig10::run(&fewer, &same, &options)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("other settings"), "{err}");
     // A run of the same plan with more trials takes up the finished ones.
     fig10(&fig10_file(&dir, "0.0", 1.0, 3), &options);
@@ -393,14 +404,14 @@ fn a_merge_takes_only_whole_parts_of_one_run() {
     let merge = |parts: &[PathBuf]| experiments::fig10::merge(parts, &dir.join("merged"));
     merge(&parts).expect("two whole parts of one run merge");
 
-    let err = merge(&parts[..1]).unwrap_err();
+    let err = merge(&parts[..1]).unwrap_err().to_string();
     assert!(err.contains("shard 2/2 is missing"), "{err}");
 
     // A part made by another plan (trials of another length).
     let other = fig10_file(&dir, "0.0", 2.0, 4);
     options.out = dir.join("other2");
     fig10(&other, &options);
-    let err = merge(&[parts[0].clone(), options.out.clone()]).unwrap_err();
+    let err = merge(&[parts[0].clone(), options.out.clone()]).unwrap_err().to_string();
     assert!(
         err.contains("other2") && err.contains("plan") && err.contains("not parts of one run"),
         "{err}"
@@ -410,7 +421,7 @@ fn a_merge_takes_only_whole_parts_of_one_run() {
     let csv = parts[1].join("fig10.csv");
     let text = std::fs::read_to_string(&csv).unwrap();
     std::fs::write(&csv, &text[..text.len() - 10]).unwrap();
-    let err = merge(&parts).unwrap_err();
+    let err = merge(&parts).unwrap_err().to_string();
     assert!(
         err.contains("shard2/fig10.csv") && err.contains("changed since it was written"),
         "{err}"
@@ -418,13 +429,13 @@ fn a_merge_takes_only_whole_parts_of_one_run() {
     let edited = text.replacen(",41,", ",42,", 1);
     assert_ne!(edited, text, "shard 2 holds trial 1, seed 41");
     std::fs::write(&csv, edited).unwrap();
-    let err = merge(&parts).unwrap_err();
+    let err = merge(&parts).unwrap_err().to_string();
     assert!(err.contains("changed since it was written"), "{err}");
 
     // A folder without its part record says what is missing.
     std::fs::write(&csv, &text).unwrap();
     std::fs::remove_file(parts[1].join("fig10.part.json")).unwrap();
-    let err = merge(&parts).unwrap_err();
+    let err = merge(&parts).unwrap_err().to_string();
     assert!(err.contains("fig10.part.json"), "{err}");
 }
 
@@ -435,12 +446,16 @@ fn a_broken_experiment_file_is_refused_with_the_file_and_the_field() {
     let good = "(radii_m: [1.0], rules: \"rules/puck-only.ron\", seconds: 1.0, trials: 1, first_seed: 1)";
     let bad = "(radii_m: [], rules: \"rules/puck-only.ron\", seconds: -1.0, trials: 0, first_seed: 1)";
     std::fs::write(&file, format!("(full: {good}, quick: {bad})")).unwrap();
-    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir)).unwrap_err();
+    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir))
+        .unwrap_err()
+        .to_string();
     for field in ["`quick.radii_m`", "`quick.seconds`", "`quick.trials`"] {
         assert!(err.contains(field) && err.contains("fig10.ron"), "{field}: {err}");
     }
     std::fs::write(&file, format!("(full: {good}, quick: (radii_m: [1.0]))")).unwrap();
-    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir)).unwrap_err();
+    let err = experiments::run_named("fig10", &default_config(), &file, &quick(&dir))
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("fig10.ron") && err.contains("quick"), "{err}");
 }
 
@@ -461,12 +476,16 @@ fn an_experiment_refuses_a_kind_without_the_levels_it_compares_rather_than_misla
         steps.replacen("creature: \"hopper\"", "creature: \"biped\"", 1),
     )
     .unwrap();
-    let err = step_response::run(&no_table, &biped_steps, &dir).unwrap_err();
+    let err = step_response::run(&no_table, &biped_steps, &dir)
+        .unwrap_err()
+        .to_string();
     assert!(
         err.contains("`creature`") && err.contains("\"biped\" has no hybrid level") && err.contains("gait_table"),
         "{err}"
     );
-    let err = step_response::run(&no_rigid, &biped_steps, &dir).unwrap_err();
+    let err = step_response::run(&no_rigid, &biped_steps, &dir)
+        .unwrap_err()
+        .to_string();
     assert!(
         err.contains("no rigid level") && err.contains("`rigid` section"),
         "{err}"
@@ -485,7 +504,8 @@ fn an_experiment_refuses_a_kind_without_the_levels_it_compares_rather_than_misla
             &experiments::default_file(&assets_root(), name),
             &quick(&dir),
         )
-        .unwrap_err();
+        .unwrap_err()
+        .to_string();
         assert!(
             err.contains(name) && err.contains("\"biped\"") && err.contains(missing),
             "{err}"
@@ -502,7 +522,9 @@ fn a_step_response_longer_than_the_models_keep_time_is_refused_not_shortened() {
     let at = steps.find("duration_s:").unwrap();
     let end = at + steps[at..].find(',').unwrap();
     std::fs::write(&file, format!("{}duration_s: 1e9{}", &steps[..at], &steps[end..])).unwrap();
-    let err = step_response::run(&default_config(), &file, &dir).unwrap_err();
+    let err = step_response::run(&default_config(), &file, &dir)
+        .unwrap_err()
+        .to_string();
     assert!(err.contains("`duration_s`") && err.contains("10000"), "{err}");
 }
 

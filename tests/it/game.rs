@@ -91,7 +91,7 @@ fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) 
             ..default()
         },
     ))
-    .add_plugins(SimPlugin { config })
+    .add_plugins(SimPlugin::new(config))
     .insert_resource(Watched::new(
         "scenarios/default.ron".to_owned(),
         root.to_path_buf(),
@@ -353,7 +353,7 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
     // 1280 by 720 window that no display shows.
     let looks: GameConfig = load_file(&assets_root().join("game.ron")).unwrap();
     let mut app = App::new();
-    app.add_plugins((MinimalPlugins, SimPlugin { config }))
+    app.add_plugins((MinimalPlugins, SimPlugin::new(config)))
         .add_plugins((
             WindowPlugin {
                 primary_window: Some(Window {

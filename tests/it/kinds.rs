@@ -153,7 +153,9 @@ fn a_kind_whose_rigid_model_falls_is_told_what_fell_and_which_numbers_to_look_at
         speeds_m_per_s: vec![0.0, 1.0],
         ..RecordSettings::default()
     };
-    let err = record(&config, "pacer", &settings).expect_err("the bound falls at 1 m/s");
+    let err = record(&config, "pacer", &settings)
+        .expect_err("the bound falls at 1 m/s")
+        .to_string();
     for words in [
         "\"pacer\" fell at",
         "commanded 1 m/s",

@@ -11,6 +11,7 @@ mod experiments;
 mod fuzz;
 mod gait;
 mod game;
+mod host;
 mod kinds;
 mod layers;
 mod outcome;

@@ -1,5 +1,6 @@
 //! The `bench` command: the cost of each level, and calibration of the budget's cost model.
 
+use crate::Failure;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -33,7 +34,7 @@ pub(crate) struct BenchArgs {
 }
 
 impl BenchArgs {
-    pub(crate) fn run(&self) -> Result<(), String> {
+    pub(crate) fn run(&self) -> Result<(), Failure> {
         let mut config = self.scenario.load_measuring(MeasuredAnew {
             cost_model: self.calibrate,
             ..MeasuredAnew::default()
@@ -42,10 +43,10 @@ impl BenchArgs {
             let all: Vec<String> = config.scenario.creatures.iter().map(|g| g.kind.clone()).collect();
             config.scenario.creatures.retain(|g| &g.kind == kind);
             if config.scenario.creatures.is_empty() {
-                return Err(format!(
+                return Err(Failure::from(format!(
                     "--kind {kind}: the scenario has no creatures of that kind (it has {})",
                     all.join(", ")
-                ));
+                )));
             }
         }
         if self.calibrate {
@@ -55,7 +56,7 @@ impl BenchArgs {
         Ok(())
     }
 
-    pub(crate) fn calibrate(&self, config: &SimConfig) -> Result<(), String> {
+    pub(crate) fn calibrate(&self, config: &SimConfig) -> Result<(), Failure> {
         let out = self
             .out
             .clone()

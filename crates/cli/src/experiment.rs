@@ -1,5 +1,6 @@
 //! The `experiment` command: the paper's experiments and those beyond it.
 
+use crate::Failure;
 use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
@@ -70,7 +71,7 @@ pub(crate) struct ExperimentRun {
 }
 
 impl ExperimentRun {
-    pub(crate) fn run(&self, name: &str) -> Result<(), String> {
+    pub(crate) fn run(&self, name: &str) -> Result<(), Failure> {
         self.scenario.refuse_level_flags(
             "experiment",
             "each experiment sets its own level policy, rules and radii from its file (assets/experiments/<name>.ron; --experiment FILE reads another)",

@@ -20,6 +20,9 @@ use crate::record_gait::RecordGaitArgs;
 use crate::run::RunArgs;
 use simlod_lab::experiments;
 
+/// Why a command failed: its message is printed after `error:`.
+type Failure = Box<dyn std::error::Error>;
+
 #[derive(Parser)]
 #[command(
     name = "simlod",
@@ -73,7 +76,7 @@ fn main() -> ExitCode {
             ExperimentKind::Crowd(run) => run.run("crowd"),
             ExperimentKind::All(run) => run.run("all"),
             ExperimentKind::Merge { dirs, out } => {
-                experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))
+                (experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))).map_err(Failure::from)
             }
         },
     };

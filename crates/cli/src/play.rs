@@ -1,5 +1,6 @@
 //! The `play` command: the game in a window.
 
+use crate::Failure;
 use clap::Parser;
 use std::path::PathBuf;
 
@@ -39,7 +40,7 @@ pub(crate) struct PlayArgs {
 
 #[cfg(feature = "game")]
 impl PlayArgs {
-    pub(crate) fn play(self) -> Result<(), String> {
+    pub(crate) fn play(self) -> Result<(), Failure> {
         let runtime_dir = private_runtime_dir();
         let played = simlod_game::play(simlod_game::PlayOptions {
             scenario: scenario_file(&self.assets, self.scenario.as_deref()),
@@ -58,7 +59,7 @@ impl PlayArgs {
         if let Some(dir) = runtime_dir {
             let _ = std::fs::remove_dir_all(dir);
         }
-        played
+        Ok(played?)
     }
 }
 

@@ -1,5 +1,6 @@
 //! The `record-gait` command: a kind's gait table recorded from its rigid model (paper 3.2).
 
+use crate::Failure;
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -29,7 +30,7 @@ pub(crate) struct RecordGaitArgs {
 }
 
 impl RecordGaitArgs {
-    pub(crate) fn run(&self) -> Result<(), String> {
+    pub(crate) fn run(&self) -> Result<(), Failure> {
         self.scenario
             .refuse_level_flags("record-gait", "it runs the kind's rigid model alone, at steady speeds")?;
         let def: CreatureDef = load_file(&self.creature).map_err(|e| e.to_string())?;
@@ -38,10 +39,10 @@ impl RecordGaitArgs {
             ..MeasuredAnew::default()
         })?;
         if def.rigid.is_none() {
-            return Err(format!(
+            return Err(Failure::from(format!(
                 "{}: the creature has no `rigid` section to record from",
                 self.creature.display()
-            ));
+            )));
         }
         let defaults = RecordSettings::up_to(def.top_speed_m_per_s);
         let speeds = self.speeds.clone().unwrap_or_else(|| defaults.speeds_m_per_s.clone());
@@ -49,9 +50,9 @@ impl RecordGaitArgs {
             || speeds.windows(2).any(|w| w[0] >= w[1])
             || speeds.iter().any(|v| !(0.0..=10.0).contains(v))
         {
-            return Err(format!(
+            return Err(Failure::from(format!(
                 "--speeds must be increasing speeds between 0 and 10 m/s, got {speeds:?}"
-            ));
+            )));
         }
         // The recording never depends on a table recorded before.
         let index = config.kind_index(&def.name).unwrap_or_else(|| {
@@ -82,14 +83,14 @@ impl RecordGaitArgs {
             && let Ok(old) = load_file::<GaitTable>(&out)
             && old.creature != def.name
         {
-            return Err(format!(
+            return Err(Failure::from(format!(
                 "{path} holds the gait table of `{other}`, not of `{kind}`: recording `{kind}` there would \
                  take `{other}`'s table away. Give `{kind}` its own `gait_table` (or --out FILE), or pass \
                  --replace-other-kind",
                 path = out.display(),
                 other = old.creature,
                 kind = def.name,
-            ));
+            )));
         }
         let table = record(&config, &def.name, &settings)?;
         let speeds: Vec<String> = speeds.iter().map(f32::to_string).collect();

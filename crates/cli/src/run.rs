@@ -1,5 +1,6 @@
 //! The `run` command: a scenario simulated without a window, and its summary.
 
+use crate::Failure;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -23,7 +24,7 @@ pub(crate) struct RunArgs {
 impl RunArgs {
     /// Simulates the scenario and prints what happened. A flag the run's policy never reads is
     /// refused rather than ignored.
-    pub(crate) fn run(&self) -> Result<(), String> {
+    pub(crate) fn run(&self) -> Result<(), Failure> {
         let config = self.scenario.load()?;
         let policy = config.scenario.level_policy;
         let unread = [
@@ -41,10 +42,10 @@ impl RunArgs {
             ),
         ];
         if let Some((flag, _)) = unread.iter().find(|(_, unread)| *unread) {
-            return Err(format!(
+            return Err(Failure::from(format!(
                 "{flag} does not apply to the {} policy, which never reads it (choose a policy that does with --policy)",
                 policy.name()
-            ));
+            )));
         }
         let seconds = self.seconds.unwrap_or(f64::from(config.scenario.duration_s));
         let summary = headless::run(config.clone(), seconds);

@@ -1,5 +1,6 @@
 //! The flags every simulating command shares: the scenario, its assets and what overrides them.
 
+use crate::Failure;
 use clap::Args;
 use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use std::path::{Path, PathBuf};
@@ -75,7 +76,7 @@ const DEFAULT_SCENARIO: &str = "scenarios/default.ron";
 impl ScenarioArgs {
     /// Refuses the level flags (policy, rules, radii, budget) for a command that never reads
     /// them, saying `why`, rather than let them be ignored without a word.
-    pub(crate) fn refuse_level_flags(&self, command: &str, why: &str) -> Result<(), String> {
+    pub(crate) fn refuse_level_flags(&self, command: &str, why: &str) -> Result<(), Failure> {
         let given = [
             ("--policy", self.policy.is_some()),
             ("--puck-radius", self.puck_radius.is_some()),
@@ -84,7 +85,9 @@ impl ScenarioArgs {
             ("--rules", self.rules.is_some()),
         ];
         match given.iter().find(|(_, given)| *given) {
-            Some((flag, _)) => Err(format!("{flag} does not apply to `simlod {command}`: {why}")),
+            Some((flag, _)) => Err(Failure::from(format!(
+                "{flag} does not apply to `simlod {command}`: {why}"
+            ))),
             None => Ok(()),
         }
     }
@@ -114,13 +117,13 @@ impl ScenarioArgs {
         }
     }
 
-    pub(crate) fn load(&self) -> Result<SimConfig, String> {
+    pub(crate) fn load(&self) -> Result<SimConfig, Failure> {
         self.load_measuring(MeasuredAnew::default())
     }
 
     /// The scenario with its overrides, without what is about to be measured anew (see
     /// [`SimConfig::load_measuring`]).
-    pub(crate) fn load_measuring(&self, anew: MeasuredAnew) -> Result<SimConfig, String> {
+    pub(crate) fn load_measuring(&self, anew: MeasuredAnew) -> Result<SimConfig, Failure> {
         let mut config =
             SimConfig::load_measuring(&self.scenario_file(), &self.assets, anew).map_err(|e| e.to_string())?;
         if let Some(rules) = &self.rules {

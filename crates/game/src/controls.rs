@@ -210,7 +210,7 @@ mod tests {
         let looks = load_file(&root.join(crate::GAME_FILE)).unwrap();
         let mut app = App::new();
         app.add_plugins(MinimalPlugins)
-            .add_plugins(SimPlugin { config })
+            .add_plugins(SimPlugin::new(config))
             .init_resource::<ButtonInput<KeyCode>>()
             .insert_resource(ColourByLevel(true))
             .insert_resource(GameSettings(looks));

@@ -73,7 +73,7 @@ pub fn play(options: PlayOptions) -> Result<(), String> {
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
     let mut app = App::new();
     add_window_plugins(&mut app, &options)?;
-    app.add_plugins(SimPlugin { config })
+    app.add_plugins(SimPlugin::new(config))
         .insert_resource(GameSettings(looks))
         .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone(), file_rules));
     plugin(&mut app);

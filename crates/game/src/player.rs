@@ -122,15 +122,13 @@ fn start_rounds(
 /// The player's creature and its rounds: everything of the game that needs no window.
 /// Add after [`simlod::SimPlugin`]: the first round is the world it built.
 pub fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     let base = BaseConfig(app.world().resource::<SimConfig>().clone());
     app.insert_resource(base)
         .add_message::<NewRound>()
         .init_resource::<Round>()
         .init_resource::<PlayerIntent>()
-        .add_systems(FixedUpdate, steer_player.in_set(SimStage::Steer))
-        .add_systems(
-            FixedUpdate,
-            keep_score.after(SimStage::Observe).before(SimStage::Outcome),
-        )
+        .add_systems(schedule, steer_player.in_set(SimStage::Steer))
+        .add_systems(schedule, keep_score.after(SimStage::Observe).before(SimStage::Outcome))
         .add_systems(Update, (start_rounds, choose_player, notice_fall).chain());
 }

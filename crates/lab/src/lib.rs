@@ -10,5 +10,8 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+mod error;
 pub mod experiments;
 pub mod record;
+
+pub use error::{LabError, io_error};

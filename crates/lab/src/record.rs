@@ -9,6 +9,7 @@
 //! speed measures the acceleration the point mass must match. The world is seeded, so the
 //! same files give the same table.
 
+use crate::LabError;
 use bevy::prelude::*;
 use std::fmt::Write as _;
 
@@ -121,7 +122,7 @@ impl<'a> Runner<'a> {
 
     /// This tick's pose and position, and the gait phase; once the creature has fallen (and
     /// was removed), an error that says how.
-    fn sample(&mut self) -> Result<(Tick, GaitPhase), String> {
+    fn sample(&mut self) -> Result<(Tick, GaitPhase), LabError> {
         let t = self.sim.clock().seconds() as f32;
         let world = self.sim.app.world();
         let e = self.creature;
@@ -130,7 +131,7 @@ impl<'a> Runner<'a> {
             world.get::<PlanarState>(e),
             world.get::<GaitPhase>(e),
         ) else {
-            return Err(fall_report(self.def, self.speed, t, self.seen));
+            return Err(LabError::Invalid(fall_report(self.def, self.speed, t, self.seen)));
         };
         let tick = Tick {
             t,
@@ -142,13 +143,13 @@ impl<'a> Runner<'a> {
     }
 
     /// One tick on.
-    fn advance(&mut self) -> Result<(Tick, GaitPhase), String> {
+    fn advance(&mut self) -> Result<(Tick, GaitPhase), LabError> {
         self.sim.advance_frame();
         self.sample()
     }
 
     /// `seconds` on, watching every tick.
-    fn run_for(&mut self, seconds: f32) -> Result<(), String> {
+    fn run_for(&mut self, seconds: f32) -> Result<(), LabError> {
         let end = self.sim.clock().seconds() + f64::from(seconds);
         while self.sim.clock().seconds() < end {
             self.advance()?;
@@ -230,7 +231,7 @@ fn record_row(
     steps: u32,
     speed: f32,
     s: &RecordSettings,
-) -> Result<GaitRow, String> {
+) -> Result<GaitRow, LabError> {
     let mut run = Runner::new(config, def, speed);
     run.run_for(s.settle_s)?;
     let mut ticks: Vec<Tick> = Vec::new();
@@ -282,11 +283,11 @@ fn record_row(
             } else {
                 format!(", too few to judge {} of them", s.hops)
             };
-            return Err(format!(
+            return Err(LabError::Invalid(format!(
                 "no steady gait at {speed} m/s within {} s: {} strides{steadiest}",
                 s.steady_within_s,
                 stride_starts.len()
-            ));
+            )));
         }
     };
     let period = strides.iter().map(|(a, b)| b - a).sum::<f32>() / strides.len() as f32;
@@ -331,7 +332,7 @@ fn pose_at(ticks: &[Tick], t: f32) -> GaitPose {
 
 /// From standing, commanded to `top`: the acceleration of the hop-averaged speed while it
 /// rises from 10 % to 70 % of `top` (the saturated part a limit describes).
-fn measure_acceleration(config: &SimConfig, def: &CreatureDef, top: f32) -> Result<f32, String> {
+fn measure_acceleration(config: &SimConfig, def: &CreatureDef, top: f32) -> Result<f32, LabError> {
     let mut run = Runner::new(config, def, 0.0);
     run.run_for(3.0)?;
     let start = run.seconds() as f32;
@@ -357,14 +358,16 @@ fn measure_acceleration(config: &SimConfig, def: &CreatureDef, top: f32) -> Resu
         }
         previous = Some((tick.t, tick.position));
     }
-    Err(format!("the rigid model never reached 70 % of {top} m/s in 20 s"))
+    Err(LabError::Invalid(format!(
+        "the rigid model never reached 70 % of {top} m/s in 20 s"
+    )))
 }
 
 /// Records the table of `kind` (which must have a rigid model in `config`).
-pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Result<GaitTable, String> {
+pub fn record(config: &SimConfig, kind: &str, settings: &RecordSettings) -> Result<GaitTable, LabError> {
     let def = &config.kinds[config
         .kind_index(kind)
-        .ok_or_else(|| format!("no creature kind {kind:?} in the scenario"))?];
+        .ok_or_else(|| LabError::Invalid(format!("no creature kind {kind:?} in the scenario")))?];
     let steps = def.stance.steps_per_stride(def.legs.len());
     let rows = settings
         .speeds_m_per_s

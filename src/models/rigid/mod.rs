@@ -461,14 +461,15 @@ fn observe_rigid(
 }
 
 pub(super) fn plugin(app: &mut App) {
+    let schedule = SimClock::schedule_of(app);
     app.add_observer(enter_rigid)
         .add_observer(leave_rigid)
-        .add_systems(FixedUpdate, controller::control_legs.in_set(SimStage::Step))
+        .add_systems(schedule, controller::control_legs.in_set(SimStage::Step))
         .add_systems(
-            FixedUpdate,
+            schedule,
             start_multibodies
                 .after(PhysicsSet::SyncBackend)
                 .before(PhysicsSet::StepSimulation),
         )
-        .add_systems(FixedUpdate, observe_rigid.in_set(SimStage::Observe));
+        .add_systems(schedule, observe_rigid.in_set(SimStage::Observe));
 }

@@ -3,6 +3,7 @@
 //! few seconds with every frame's simulation timed: the mean and slowest frame, and the
 //! creatures at each level. A policy stops at the first size where a frame passes the limit.
 
+use crate::LabError;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -112,7 +113,7 @@ fn peak_memory_mb() -> Option<f64> {
 
 /// Runs the crowd experiment from `file`; writes its CSV, plot, JSON and report and returns
 /// what it says.
-pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: CrowdSettings = load_settings(file, options)?;
     let stop_ms = f64::from(s.stop_frame_ms);
     let mut progress = super::Progress::new("crowd", (s.policies.len() * s.creatures.len()) as u64);

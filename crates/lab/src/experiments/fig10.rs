@@ -3,7 +3,11 @@
 //! trial all rigid; the measure is the paper's, the creatures that collided with the puck or a
 //! wall. Trials are independent: they run on `--jobs` threads, split into `--shard`s, and an
 //! interrupted run resumes from `fig10.partial.csv` without redoing finished trials.
+//!
+//! Over 600 lines: the trials, the shards, resuming and merging all read and write the rows of
+//! one CSV file, kept in one place.
 
+use crate::{LabError, io_error};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -96,49 +100,50 @@ fn plan_digest(config: &SimConfig, rules: &LevelRules, s: &Fig10Settings) -> Str
 }
 
 /// Reads `dir`'s part record and checks its CSV against it.
-fn read_part(dir: &Path) -> Result<(Part, Vec<Row>), String> {
+fn read_part(dir: &Path) -> Result<(Part, Vec<Row>), LabError> {
     let (csv_path, part_path) = (dir.join("fig10.csv"), dir.join(PART_FILE));
     let csv = std::fs::read(&csv_path).map_err(|e| {
-        format!(
+        LabError::Invalid(format!(
             "{}: {e} (is {} a finished fig10 run or shard?)",
             csv_path.display(),
             dir.display()
-        )
+        ))
     })?;
     let part: Part = std::fs::read_to_string(&part_path)
         .map_err(|e| {
-            format!(
+            LabError::Invalid(format!(
                 "{}: {e}: without it nothing says what made {}",
                 part_path.display(),
                 csv_path.display()
-            )
+            ))
         })
         .and_then(|json| {
-            serde_json::from_str(&json).map_err(|e| format!("{}: not a fig10 part record: {e}", part_path.display()))
+            serde_json::from_str(&json)
+                .map_err(|e| LabError::Invalid(format!("{}: not a fig10 part record: {e}", part_path.display())))
         })?;
     if part.experiment != "fig10" {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: a part of {}, not of fig10",
             part_path.display(),
             part.experiment
-        ));
+        )));
     }
     if digest(&csv) != part.checksum {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: changed since it was written (its checksum is {}, its part record says {}): cut short, edited or copied from another run",
             csv_path.display(),
             digest(&csv),
             part.checksum
-        ));
+        )));
     }
     let rows = read_rows(&csv_path)?.unwrap_or_default();
     if rows.len() != part.rows {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: {} rows, and its part record says {}",
             csv_path.display(),
             rows.len(),
             part.rows
-        ));
+        )));
     }
     Ok((part, rows))
 }
@@ -231,7 +236,7 @@ impl Row {
 }
 
 /// The rows of a `fig10.csv` (or a partial one); `None` if the file does not exist.
-pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, String> {
+pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, LabError> {
     let Ok(text) = std::fs::read_to_string(path) else {
         return Ok(None);
     };
@@ -239,18 +244,21 @@ pub fn read_rows(path: &Path) -> Result<Option<Vec<Row>>, String> {
 }
 
 /// The rows of a fig10 table's `text`, read from `path`.
-fn rows_of(text: &str, path: &Path) -> Result<Vec<Row>, String> {
+fn rows_of(text: &str, path: &Path) -> Result<Vec<Row>, LabError> {
     let mut lines = text.lines();
     if lines.next() != Some(HEADER) {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: not a fig10 table (its first line is not `{HEADER}`)",
             path.display()
-        ));
+        )));
     }
     lines
         .enumerate()
         .filter(|(_, l)| !l.is_empty())
-        .map(|(i, l)| Row::parse(l).ok_or_else(|| format!("{}: line {}: not a fig10 row: {l}", path.display(), i + 2)))
+        .map(|(i, l)| {
+            Row::parse(l)
+                .ok_or_else(|| LabError::Invalid(format!("{}: line {}: not a fig10 row: {l}", path.display(), i + 2)))
+        })
         .collect()
 }
 
@@ -289,16 +297,16 @@ fn run_trial(config: &SimConfig, rules: &LevelRules, s: &Fig10Settings, trial: u
 
 /// Runs figure 10 from `file`: this shard's trials on `--jobs` threads, resuming an interrupted
 /// run; writes its CSV, plot, JSON and report and returns what it says.
-pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: Fig10Settings = load_settings(file, options)?;
     let rules: LevelRules = load_file(&options.assets.join(&s.rules))
-        .map_err(|e| format!("{e} (named by {}: field `rules`)", file.display()))?;
+        .map_err(|e| LabError::Invalid(format!("{e} (named by {}: field `rules`)", file.display())))?;
     let s = Fig10Settings {
         trials: trials(options, s.trials),
         ..s
     };
     let out = &options.out;
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
     let (done_path, partial_path) = (out.join("fig10.csv"), out.join("fig10.partial.csv"));
     let plan = plan_digest(config, &rules, &s);
     // What an earlier run of the same plan finished, whole trials only; a part made by another
@@ -312,18 +320,18 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     let journal_plan = out.join(JOURNAL_PLAN_FILE);
     if partial_path.exists() {
         let made_by = std::fs::read_to_string(&journal_plan).map_err(|e| {
-            format!(
+            LabError::Invalid(format!(
                 "{}: {e}: without it nothing says what made {}",
                 journal_plan.display(),
                 partial_path.display()
-            )
+            ))
         })?;
         let (version, made_by) = made_by.trim().split_once(' ').unwrap_or(("", made_by.trim()));
         same_plan(made_by, version, &plan, &partial_path)?;
         earlier.extend(read_journal(&partial_path)?);
     }
     std::fs::write(&journal_plan, format!("{} {plan}\n", env!("CARGO_PKG_VERSION")))
-        .map_err(|e| format!("cannot write {}: {e}", journal_plan.display()))?;
+        .map_err(io_error("write", &journal_plan))?;
     let mine: Vec<u32> = (0..s.trials).filter(|&t| options.shard.owns(t)).collect();
     let settings = &s;
     let wanted: BTreeSet<_> = mine
@@ -357,11 +365,11 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     for row in by_trial.values().flatten() {
         journal_text += &(row.to_csv() + "\n");
     }
-    std::fs::write(&partial_path, journal_text).map_err(|e| format!("cannot write {}: {e}", partial_path.display()))?;
+    std::fs::write(&partial_path, journal_text).map_err(io_error("write", &partial_path))?;
     let mut journal = std::fs::OpenOptions::new()
         .append(true)
         .open(&partial_path)
-        .map_err(|e| format!("cannot open {}: {e}", partial_path.display()))?;
+        .map_err(io_error("open", &partial_path))?;
     let mut progress = super::Progress::new("fig10 trials", todo.len() as u64);
     let mut failed = None;
     run_parallel(
@@ -371,7 +379,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         |&t, rows| {
             let text: String = rows.iter().map(|r| r.to_csv() + "\n").collect();
             if let Err(e) = journal.write_all(text.as_bytes()).and_then(|()| journal.flush()) {
-                failed = Some(format!("cannot write {}: {e}", partial_path.display()));
+                failed = Some(io_error("write", &partial_path)(e));
             }
             by_trial.insert(t, rows);
             progress.inc();
@@ -408,27 +416,27 @@ struct PartOf {
 }
 
 /// Refuses `file`, made by plan `made_by` with simlod `version`, for a run of plan `plan`.
-fn same_plan(made_by: &str, version: &str, plan: &str, file: &Path) -> Result<(), String> {
+fn same_plan(made_by: &str, version: &str, plan: &str, file: &Path) -> Result<(), LabError> {
     let this = env!("CARGO_PKG_VERSION");
     if version != this {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: made by simlod {version}, and this is {this}: move it away or write to another --out",
             file.display()
-        ));
+        )));
     }
     if made_by != plan {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: made with other settings (plan {made_by}; this run's is {plan}: the scenario, its files, the rules, the radii, the trial length or the seeds differ): move it away or write to another --out",
             file.display()
-        ));
+        )));
     }
     Ok(())
 }
 
 /// The rows of an unfinished run's journal. Its last line, cut short by the interruption
 /// (no line end), is a trial that did not finish: dropped, and the trial runs again.
-fn read_journal(path: &Path) -> Result<Vec<Row>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+fn read_journal(path: &Path) -> Result<Vec<Row>, LabError> {
+    let text = std::fs::read_to_string(path).map_err(io_error("read", &path))?;
     let whole = text.rfind('\n').map_or("", |end| &text[..=end]);
     if whole.len() < text.len() {
         eprintln!(
@@ -440,7 +448,7 @@ fn read_journal(path: &Path) -> Result<Vec<Row>, String> {
 }
 
 /// `simlod experiment merge DIR... --out OUT`: the shards' rows as one run's.
-pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
+pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, LabError> {
     let mut rows = Vec::new();
     let mut seen = BTreeSet::new();
     let mut first: Option<(&Path, Part, Shard)> = None;
@@ -450,7 +458,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
         let shard: Shard = part
             .shard
             .parse()
-            .map_err(|e| format!("{}: field `shard`: {e}", dir.join(PART_FILE).display()))?;
+            .map_err(|e| LabError::Invalid(format!("{}: field `shard`: {e}", dir.join(PART_FILE).display())))?;
         if let Some((first_dir, f, f_shard)) = &first {
             for (what, this, that) in [
                 ("simlod version", &part.version, &f.version),
@@ -463,43 +471,43 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<String, String> {
                 ("number of shards", &shard.n.to_string(), &f_shard.n.to_string()),
             ] {
                 if this != that {
-                    return Err(format!(
+                    return Err(LabError::Invalid(format!(
                         "{}: its {what} is {this}, and {}'s is {that}: they are not parts of one run",
                         dir.display(),
                         first_dir.display()
-                    ));
+                    )));
                 }
             }
         }
         if !shards.insert(shard.k) {
-            return Err(format!(
+            return Err(LabError::Invalid(format!(
                 "{}: shard {} is given twice: the parts overlap",
                 dir.display(),
                 part.shard
-            ));
+            )));
         }
         for row in part_rows {
             if !seen.insert(row.key()) {
-                return Err(format!(
+                return Err(LabError::Invalid(format!(
                     "{}: trial {} (seed {}) at {} m is also in another part: the parts overlap",
                     dir.join("fig10.csv").display(),
                     row.trial,
                     row.seed,
                     row.puck_radius_m
-                ));
+                )));
             }
             rows.push(row);
         }
         first.get_or_insert((dir.as_path(), part, shard));
     }
     let Some((first_dir, first, Shard { n, .. })) = first else {
-        return Err("name the folders of the parts to merge".to_owned());
+        return Err(LabError::Invalid("name the folders of the parts to merge".to_owned()));
     };
     if let Some(k) = (1..=n).find(|k| !shards.contains(k)) {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "shard {k}/{n} is missing: merged, the parts would not be one run's {} trials",
             first.trials
-        ));
+        )));
     }
     let record = std::fs::read_to_string(first_dir.join("fig10.json"))
         .ok()
@@ -587,8 +595,8 @@ fn finish(
     (scenario, assets): (&Path, &Path),
     smoke_test: bool,
     part: &PartOf,
-) -> Result<String, String> {
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+) -> Result<String, LabError> {
+    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
     rows.sort_by(|a, b| a.puck_radius_m.total_cmp(&b.puck_radius_m).then(a.trial.cmp(&b.trial)));
     let mut csv = format!("{HEADER}\n");
     for row in &rows {

@@ -2,6 +2,7 @@
 //! percentage of them that are rigid (the rest hybrid; no point masses, every creature in
 //! the game's steering and collisions). Levels are set by the experiment and held.
 
+use crate::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -85,7 +86,7 @@ fn mixed_frame_seconds(base: &SimConfig, n: u32, percent: u32, warmup: usize, fr
 
 /// Runs figure 7 from `file`: for each rigid percentage, searches for the most creatures at
 /// 30 fps; writes its CSV, plot, JSON and report and returns what it says.
-pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: Fig7Settings = load_settings(file, options)?;
     check_kind(config, file, "creature", &s.creature, &[Lod::Hybrid, Lod::Rigid])?;
     let base = only_kind(config, &s.creature);

@@ -3,6 +3,7 @@
 //! (figure 9: out of view point mass, in view hybrid, in view and near rigid). A frame is
 //! 1/30 s of motion; its rate is frames per second of wall time, headless.
 
+use crate::LabError;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -101,12 +102,12 @@ struct Point {
 
 /// Runs figure 8 or 9 (`name`) from `file`: timed games at each radius under each rules file;
 /// writes its CSV, plot, JSON and report and returns what it says.
-pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: FrameRateSettings = load_settings(file, options)?;
     let mut variants = Vec::new();
     for (i, v) in s.rules.iter().enumerate() {
         let rules: LevelRules = load_file(&options.assets.join(&v.file))
-            .map_err(|e| format!("{} (named by {}: field `rules[{i}].file`)", e, file.display()))?;
+            .map_err(|e| LabError::Invalid(format!("{} (named by {}: field `rules[{i}].file`)", e, file.display())))?;
         variants.push((v, rules));
     }
     let n_trials = trials(options, s.trials);

@@ -23,6 +23,7 @@ pub use progress::Progress;
 /// in: room for a long run without meeting a wall.
 pub const EXPERIMENT_COURT_M: f32 = 300.0;
 
+use crate::{LabError, io_error};
 use bevy::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -106,8 +107,8 @@ impl<S: Validate> Validate for ExperimentFile<S> {
 }
 
 /// The settings `options` ask for from an experiment file, validated.
-pub fn load_settings<S: DeserializeOwned + Validate>(file: &Path, options: &Options) -> Result<S, String> {
-    let f: ExperimentFile<S> = load_file(file).map_err(|e| e.to_string())?;
+pub fn load_settings<S: DeserializeOwned + Validate>(file: &Path, options: &Options) -> Result<S, LabError> {
+    let f: ExperimentFile<S> = load_file(file)?;
     Ok(if options.quick { f.quick } else { f.full })
 }
 
@@ -118,14 +119,16 @@ pub fn trials(options: &Options, from_file: u32) -> u32 {
 
 /// Checks that a creature kind named in experiment `file` is one the scenario has, with every
 /// level in `levels`.
-pub fn check_kind(config: &SimConfig, file: &Path, field: &str, kind: &str, levels: &[Lod]) -> Result<(), String> {
+pub fn check_kind(config: &SimConfig, file: &Path, field: &str, kind: &str, levels: &[Lod]) -> Result<(), LabError> {
     let Some(i) = config.kind_index(kind) else {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "{}: field `{field}`: the scenario has no creature kind {kind:?}",
             file.display()
-        ));
+        )));
     };
-    lacking_level(config, i, levels).map_or(Ok(()), |why| Err(format!("{}: field `{field}`: {why}", file.display())))
+    lacking_level(config, i, levels).map_or(Ok(()), |why| {
+        Err(LabError::Invalid(format!("{}: field `{field}`: {why}", file.display())))
+    })
 }
 
 /// The levels experiment `name` compares across the scenario's whole mix. A kind without one
@@ -173,7 +176,8 @@ pub fn only_kind(config: &SimConfig, kind: &str) -> SimConfig {
 /// and `stages` (for example steering and collisions) do not run.
 pub fn hold_levels(sim: &mut HeadlessSim, stages: &[SimStage]) {
     for &stage in [SimStage::SelectLod, SimStage::Switch].iter().chain(stages) {
-        sim.app.configure_sets(FixedUpdate, stage.run_if(|| false));
+        let schedule = simlod::contract::SimClock::schedule_of(&sim.app);
+        sim.app.configure_sets(schedule, stage.run_if(|| false));
     }
 }
 
@@ -222,10 +226,10 @@ pub fn run_parallel<T: Sync, R: Send>(
 }
 
 /// Writes one of an experiment's files into the output folder.
-pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, String> {
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, LabError> {
+    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
     let path = out.join(file);
-    std::fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    std::fs::write(&path, text).map_err(io_error("write", &path))?;
     Ok(path)
 }
 
@@ -248,7 +252,7 @@ pub struct ExperimentRecord {
 
 impl ExperimentRecord {
     /// Writes `<name>.csv`, `<name>.json` and the report (the plot is drawn before).
-    pub fn finish(&self, out: &Path, csv: &str) -> Result<String, String> {
+    pub fn finish(&self, out: &Path, csv: &str) -> Result<String, LabError> {
         let name = &self.experiment;
         write_out(out, &format!("{name}.csv"), csv)?;
         self.save(out, &[&format!("{name}.csv"), &format!("{name}.png")])
@@ -256,7 +260,7 @@ impl ExperimentRecord {
 
     /// Writes `<name>.json` and the report, and says so with the `other` files the experiment
     /// wrote before.
-    pub fn save(&self, out: &Path, other: &[&str]) -> Result<String, String> {
+    pub fn save(&self, out: &Path, other: &[&str]) -> Result<String, LabError> {
         let name = &self.experiment;
         let json = serde_json::to_string_pretty(self).expect("a record serialises");
         write_out(out, &format!("{name}.json"), &(json + "\n"))?;
@@ -384,19 +388,19 @@ pub fn default_file(assets: &Path, name: &str) -> PathBuf {
 }
 
 /// Runs experiment `name` from `file` into `options.out`; returns what it says.
-pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     if options.shard != Shard::WHOLE && name != "fig10" {
-        return Err(format!(
+        return Err(LabError::Invalid(format!(
             "--shard splits fig10's trials only; {name} measures one thing at a time on one machine"
-        ));
+        )));
     }
     for group in &config.scenario.creatures {
         let i = config.kind_index(&group.kind).expect("a loaded scenario's kinds exist");
         if let Some(why) = lacking_level(config, i, compared_levels(name)) {
-            return Err(format!("{name} cannot run this scenario: {why}"));
+            return Err(LabError::Invalid(format!("{name} cannot run this scenario: {why}")));
         }
     }
-    std::fs::create_dir_all(&options.out).map_err(|e| format!("cannot create {}: {e}", options.out.display()))?;
+    std::fs::create_dir_all(&options.out).map_err(io_error("create", &options.out))?;
     match name {
         "step-response" => step_response::run(config, file, &options.out),
         "table1" => table1::run(config, file, options),
@@ -405,6 +409,9 @@ pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options)
         "fig10" => fig10::run(config, file, options),
         "budget" => budget::run(config, file, options),
         "crowd" => crowd::run(config, file, options),
-        _ => Err(format!("no experiment {name:?}; there are {}", ALL.join(", "))),
+        _ => Err(LabError::Invalid(format!(
+            "no experiment {name:?}; there are {}",
+            ALL.join(", ")
+        ))),
     }
 }

@@ -1,6 +1,9 @@
 //! The experiments' plots: PNG files drawn with plotters' bitmap backend, text in the DejaVu
 //! Sans font shipped in `assets/fonts` (no system fonts, no system packages).
+//!
+//! Over 600 lines with its unit tests, which check each kind of plot is drawn and not blank.
 
+use crate::LabError;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::Path;
@@ -220,9 +223,9 @@ pub fn draw(
     height: u32,
     panels: &[Panel],
     smoke_test: bool,
-) -> Result<Vec<PanelLayout>, String> {
+) -> Result<Vec<PanelLayout>, LabError> {
     register();
-    let fail = |e: &dyn std::fmt::Display| format!("cannot draw {}: {e}", path.display());
+    let fail = |e: &dyn std::fmt::Display| LabError::Invalid(format!("cannot draw {}: {e}", path.display()));
     let root = BitMapBackend::new(path, (width, height)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| fail(&e))?;
     let area = if smoke_test {

@@ -1,6 +1,7 @@
 //! `report.md`: every experiment run into a folder, in the paper's order, each with its plot,
 //! what the paper reports, what we measured and how they compare (from each `<name>.json`).
 
+use crate::LabError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -19,7 +20,7 @@ pub const ORDER: [&str; 8] = [
 ];
 
 /// Rewrites `report.md` in `out` from the experiments whose JSON is there.
-pub fn write(out: &Path) -> Result<PathBuf, String> {
+pub fn write(out: &Path) -> Result<PathBuf, LabError> {
     let mut text = String::from(
         "# simlod: the paper's results, reproduced\n\n\
          Carlson & Hodgins, *Simulation Levels of Detail for Real-time Animation* (GI '97), section 4. \
@@ -31,8 +32,8 @@ pub fn write(out: &Path) -> Result<PathBuf, String> {
         let Ok(json) = std::fs::read_to_string(&path) else {
             continue;
         };
-        let record: ExperimentRecord =
-            serde_json::from_str(&json).map_err(|e| format!("{}: not an experiment record: {e}", path.display()))?;
+        let record: ExperimentRecord = serde_json::from_str(&json)
+            .map_err(|e| LabError::Invalid(format!("{}: not an experiment record: {e}", path.display())))?;
         let smoke_test = if record.smoke_test {
             "**Smoke test** (`--quick`): small counts and short games that check the pipeline runs. \
              Its numbers are not findings, and no sentence below is a conclusion.\n\n"

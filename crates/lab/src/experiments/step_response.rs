@@ -3,6 +3,7 @@
 //! 3.2: "even small differences in velocity can result in substantial changes in final
 //! position").
 
+use crate::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -13,7 +14,7 @@ use super::{EXPERIMENT_COURT_M, ExperimentRecord, lone_creature, write_out};
 
 /// A run starts at least this far inside the experiment's court: 8 s at 3 m/s is 24 m.
 const START_MARGIN_M: f32 = 50.0;
-use simlod::config::{ConfigError, SimConfig, Validate, Validator, load_file};
+use simlod::config::{SimConfig, Validate, Validator, load_file};
 use simlod::creature::{DesiredVelocity, PlanarState};
 use simlod::lod::{LevelPolicy, Lod};
 
@@ -123,8 +124,8 @@ pub fn trace(
 
 /// Writes `velocity.csv` (figure 3), `path.csv` (figure 4) and `final.csv` (where each model
 /// ended, and how far apart) into `out`; returns a summary.
-pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result<String, String> {
-    let experiment: StepResponseConfig = load_file(experiment_file).map_err(|e: ConfigError| e.to_string())?;
+pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result<String, LabError> {
+    let experiment: StepResponseConfig = load_file(experiment_file)?;
     super::check_kind(
         sim_config,
         experiment_file,
@@ -211,7 +212,7 @@ pub fn run(sim_config: &SimConfig, experiment_file: &Path, out: &Path) -> Result
 }
 
 /// Figure 3 (speed against time) and figure 4 (the paths on the ground) side by side.
-fn draw(traces: &[Trace], file: &Path) -> Result<(), String> {
+fn draw(traces: &[Trace], file: &Path) -> Result<(), LabError> {
     let mut speed = Vec::new();
     let mut path = Vec::new();
     if let Some(first) = traces.first() {

@@ -3,6 +3,7 @@
 //! rendering: every creature runs at a set speed in its own direction), and, in a second
 //! column, the whole per-creature cost of a game (steering, level rules and collisions).
 
+use crate::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
@@ -85,7 +86,7 @@ type KindCosts = [Option<[f64; 2]>; 3];
 
 /// Runs table 1 from `file`: ms per creature per 1/30 s at each level, model alone and in the
 /// game; writes its CSV, plot, JSON and report and returns what it says.
-pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, String> {
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: Table1Settings = load_settings(file, options)?;
     for (i, kind) in s.kinds.iter().enumerate() {
         check_kind(config, file, &format!("kinds[{i}]"), kind, &[])?;
