@@ -77,6 +77,7 @@ pub mod prelude {
     };
     pub use crate::headless::{HeadlessSim, run_ticks_per_update};
     pub use crate::kind::{Creature, KindTable};
+    pub use crate::lod::{InfluenceArea, LevelChoice};
     pub use crate::outcome::{Summary, summarize};
     pub use crate::plugin::{SimPlugin, start_over};
 }

@@ -10,6 +10,7 @@ mod creature;
 pub mod gait;
 mod game;
 mod loader;
+mod overrides;
 mod rules;
 mod scenario;
 mod validate;
@@ -25,6 +26,7 @@ pub use game::{
     CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig, SceneColours, Srgb,
 };
 pub use loader::{RonAssetLoader, load_file, parse_ron};
+pub use overrides::Overrides;
 pub use rules::{BudgetRules, CameraRules, InfluenceRules, LevelRules};
 pub use scenario::{CreatureGroup, LevelPolicy, MAX_CREATURES, MAX_DURATION_S, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator, number};

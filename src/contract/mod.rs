@@ -70,8 +70,8 @@ pub enum SimStage {
     Clock,
 }
 
-/// Builds the simulated world from [`SimConfig`]: run once at `Startup`, and again by
-/// [`start_over`]. Each module adds the systems that set up its part of the world here.
+/// Builds the simulated world from [`crate::config::SimConfig`]: run once at `Startup`, and again by
+/// [`crate::start_over`]. Each module adds the systems that set up its part of the world here.
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
 pub struct SimStart;
 

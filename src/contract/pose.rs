@@ -107,7 +107,7 @@ impl GaitPose {
         pose
     }
 
-    /// As a table's sample (see [`columns`]).
+    /// As a table's sample (see [`crate::config::gait::columns`]).
     pub fn to_row(&self) -> Vec<f32> {
         [self.body_height_m, self.roll_rad, self.pitch_rad]
             .into_iter()

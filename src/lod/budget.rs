@@ -25,7 +25,7 @@ use bevy::prelude::*;
 use serde::Serialize;
 use std::cell::Cell;
 
-use super::select::{DecisionInputs, LevelChoice, SimCamera, select_levels, start_at_selected_levels};
+use super::select::{Area, DecisionInputs, LevelChoice, SimCamera, areas_now, select_levels, start_at_selected_levels};
 use super::{LevelPolicy, Lod};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::contract::GaitPose;
@@ -289,6 +289,8 @@ const NEAREST_RING_M: f32 = 4.0;
 struct Scene<'a> {
     rules: &'a BudgetRules,
     puck: &'a PuckState,
+    /// The host's areas of influence, weighed as the puck is.
+    areas: Vec<Area>,
     court: &'a Court,
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
@@ -308,17 +310,26 @@ impl Scene<'_> {
             .max(self.rules.worst_case_share * (-t_worst / h).exp())
     }
 
+    /// How urgent a contact is with a circle of `circle_radius` at `centre` moving at `velocity`.
+    fn circle(&self, s: &PlanarState, radius: f32, centre: Vec2, velocity: Vec2, circle_radius: f32) -> f32 {
+        let d = s.position - centre;
+        let reach = radius + circle_radius + self.rules.contact_margin_m;
+        let gap = (d.length() - reach).max(0.0);
+        let closing = self.top_speed + velocity.length();
+        let t = time_to_contact(d, s.velocity - velocity, reach);
+        self.urgency(t, gap / closing.max(1e-3))
+    }
+
     /// Benefit of the rigid level from how soon a contact could come.
     fn contact(&self, c: &Creature, s: &PlanarState, radius: f32) -> f32 {
         let (r, margin) = (self.rules, self.rules.contact_margin_m);
         let mut best = 0.0f32;
-        // The puck.
-        let d = s.position - self.puck.position;
-        let reach = radius + self.puck.radius_m + margin;
-        let gap = (d.length() - reach).max(0.0);
-        let closing = self.top_speed + self.puck.velocity.length();
-        let t = time_to_contact(d, s.velocity - self.puck.velocity, reach);
-        best = best.max(r.puck_weight * self.urgency(t, gap / closing.max(1e-3)));
+        // The puck, and the host's areas of influence.
+        let puck = self.puck;
+        best = best.max(r.puck_weight * self.circle(s, radius, puck.position, puck.velocity, puck.radius_m));
+        for a in &self.areas {
+            best = best.max(r.puck_weight * self.circle(s, radius, a.position, a.velocity, a.radius_m));
+        }
         // The walls: the nearest on each axis.
         let room = self.court.half_extents - Vec2::splat(radius + margin) - s.position.abs();
         let along = s.velocity * s.position.signum();
@@ -449,6 +460,7 @@ fn scene<'a>(
     config: &'a SimConfig,
     kinds: &KindTable,
     puck: &'a PuckState,
+    areas: Vec<Area>,
     court: &'a Court,
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
@@ -459,6 +471,7 @@ fn scene<'a>(
     Scene {
         rules,
         puck,
+        areas,
         court,
         grid,
         camera,
@@ -468,7 +481,7 @@ fn scene<'a>(
     }
 }
 
-impl DecisionInputs<'_> {
+impl DecisionInputs<'_, '_> {
     /// The allocation for every creature now, in the order of their serials: within the
     /// budget as the cost model predicts it, times `correction`.
     fn decide(&self, creatures: &Creatures, correction: f32) -> (Vec<Entity>, Allocation) {
@@ -477,6 +490,7 @@ impl DecisionInputs<'_> {
             &self.config,
             &self.kinds,
             &self.puck,
+            areas_now(&self.areas),
             &self.court,
             &self.grid,
             &self.camera,
@@ -634,6 +648,7 @@ mod tests {
         let scene = Scene {
             rules: b,
             puck: &puck,
+            areas: Vec::new(),
             court: &court,
             grid: &grid,
             camera: &camera,

@@ -23,6 +23,7 @@
 
 use bevy::ecs::system::SystemParam;
 use bevy::prelude::*;
+use bevy_rapier3d::prelude::Velocity;
 
 use super::{LevelPolicy, Lod};
 use crate::config::{LevelRules, SimConfig};
@@ -152,9 +153,44 @@ pub fn in_influence(q: Vec2, p: Vec2, v: Vec2, radius: f32, lookahead_s: f32) ->
     x * x + y * y <= 1.0
 }
 
+/// An area of influence of the host's own, beside the puck's and each creature's (figure 5):
+/// under the influence rule a creature inside it, or about to be within the rules' lookahead,
+/// is simulated rigid, as near the puck; the budget spends on it as on the puck. Put it on any
+/// entity with a `Transform`; a rapier `Velocity` beside it is its motion on the ground plane.
+#[derive(Component, Clone, Copy, Debug)]
+pub struct InfluenceArea {
+    /// The area's radius on the ground plane, metres.
+    pub radius_m: f32,
+}
+
+/// A host's area of influence at one decision, on the ground plane.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Area {
+    pub position: Vec2,
+    pub velocity: Vec2,
+    pub radius_m: f32,
+}
+
+/// The host's areas of influence (none in simlod's own game).
+pub(super) type Areas<'w, 's> = Query<'w, 's, (&'static InfluenceArea, &'static Transform, Option<&'static Velocity>)>;
+
+/// Where each of the host's areas is now.
+pub(super) fn areas_now(areas: &Areas) -> Vec<Area> {
+    areas
+        .iter()
+        .map(|(area, transform, velocity)| Area {
+            position: transform.translation.xz(),
+            velocity: velocity.map_or(Vec2::ZERO, |v| v.linear.xz()),
+            radius_m: area.radius_m,
+        })
+        .collect()
+}
+
 /// The areas' radii and the view's margin, to enter them or, grown by the release margin,
 /// to stay in them (the hysteresis).
 struct Radii {
+    /// What the release margin adds (0 to enter).
+    grow: f32,
     puck: f32,
     creature: f32,
     wall: f32,
@@ -167,6 +203,7 @@ impl Radii {
     fn of(rules: &LevelRules, staying: bool) -> Self {
         let grow = if staying { rules.release_margin_m } else { 0.0 };
         Self {
+            grow,
             puck: rules.influence.puck_radius_m + grow,
             creature: rules.influence.creature_radius_m + grow,
             wall: rules.influence.wall_band_m + grow,
@@ -178,7 +215,7 @@ impl Radii {
 
 /// What a decision on levels reads besides the creatures (every policy's).
 #[derive(SystemParam)]
-pub(super) struct DecisionInputs<'w> {
+pub(super) struct DecisionInputs<'w, 's> {
     pub clock: Res<'w, SimClock>,
     pub config: Res<'w, SimConfig>,
     pub kinds: Res<'w, KindTable>,
@@ -186,9 +223,10 @@ pub(super) struct DecisionInputs<'w> {
     pub court: Res<'w, Court>,
     pub grid: Res<'w, NeighbourGrid>,
     pub camera: Res<'w, SimCamera>,
+    pub areas: Areas<'w, 's>,
 }
 
-impl DecisionInputs<'_> {
+impl DecisionInputs<'_, '_> {
     /// The areas of influence and the camera rule, over these inputs.
     fn rules(&self) -> LevelInputs<'_> {
         let rules = &self.config.rules;
@@ -200,6 +238,7 @@ impl DecisionInputs<'_> {
             grid: &self.grid,
             camera: &self.camera,
             kinds: &self.kinds,
+            areas: areas_now(&self.areas),
             reach_m: rules.release_margin_m + top_speed * rules.influence.lookahead_s,
         }
     }
@@ -212,6 +251,7 @@ struct LevelInputs<'a> {
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
     kinds: &'a KindTable,
+    areas: Vec<Area>,
     reach_m: f32,
 }
 
@@ -226,13 +266,15 @@ impl LevelInputs<'_> {
             r.puck + self.puck.radius_m,
             la,
         );
+        let in_area =
+            || (self.areas.iter()).any(|a| in_influence(s.position, a.position, a.velocity, a.radius_m + r.grow, la));
         let mut in_creature = false;
-        if !(near_wall || in_puck) {
+        if !(near_wall || in_puck || in_area()) {
             self.grid.for_each_within(s.position, self.reach_m + r.creature, |n| {
                 in_creature |= n.serial != c.serial && in_influence(s.position, n.position, n.velocity, r.creature, la);
             });
         }
-        if near_wall || in_puck || in_creature {
+        if near_wall || in_puck || in_creature || in_area() {
             Lod::Rigid
         } else {
             Lod::Hybrid

@@ -116,3 +116,37 @@ fn the_simulation_runs_in_the_schedule_the_host_gives_it_and_only_there() {
         .count();
     assert!(moved > 30, "a simulated second moved the creatures: {moved} of 40");
 }
+
+#[test]
+fn an_area_of_influence_of_the_hosts_own_makes_a_creature_in_it_rigid() {
+    let mut config = default_config();
+    config.scenario.level_policy = LevelPolicy::Influence;
+    // After 4 s, the creature the rule wants hybrid that is farthest from the puck; then the
+    // level the rule wants for it a frame later, with or without an area of the host's there.
+    let wanted_after = |area: bool| {
+        let mut sim = HeadlessSim::new(config.clone());
+        sim.run_for(4.0);
+        let world = sim.app.world_mut();
+        let puck = world.resource::<simlod::arena::PuckState>().position;
+        let (serial, at) = world
+            .query::<(&Creature, &PlanarState, &LevelChoice)>()
+            .iter(world)
+            .filter(|(_, _, choice)| choice.wanted == Lod::Hybrid)
+            .max_by(|a, b| a.1.position.distance(puck).total_cmp(&b.1.position.distance(puck)))
+            .map(|(c, s, _)| (c.serial, s.position))
+            .expect("a hybrid creature");
+        if area {
+            world.spawn((InfluenceArea { radius_m: 1.0 }, Transform::from_xyz(at.x, 0.0, at.y)));
+        }
+        sim.advance_frame();
+        let world = sim.app.world_mut();
+        world
+            .query::<(&Creature, &LevelChoice)>()
+            .iter(world)
+            .find(|(c, _)| c.serial == serial)
+            .map(|(_, choice)| choice.wanted)
+            .expect("the creature is still there")
+    };
+    assert_eq!(wanted_after(false), Lod::Hybrid);
+    assert_eq!(wanted_after(true), Lod::Rigid);
+}

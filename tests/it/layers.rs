@@ -7,7 +7,10 @@ use std::path::{Path, PathBuf};
 
 /// Bottom to top. A module may import any module of a lower layer, and of its own layer only
 /// those listed before it.
-const LAYERS: &[(&str, &[&str])] = &[
+type Layers = &'static [(&'static str, &'static [&'static str])];
+
+/// The core library's layers.
+const LAYERS: Layers = &[
     ("the level contract", &["contract"]),
     ("kinds and their files", &["config", "kind", "third_party"]),
     ("sense", &["sense"]),
@@ -18,9 +21,16 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("the headless harness", &["headless"]),
 ];
 
-/// Where `module` stands: its place in the order, and its layer's name.
-fn rank(module: &str) -> Option<(usize, &'static str)> {
-    LAYERS
+/// The lab's: the tools build on the scenes they run, and the experiments on the bench.
+const LAB_LAYERS: Layers = &[
+    ("the scenes", &["scene", "error"]),
+    ("the bench and the recorder", &["bench", "record"]),
+    ("the experiments", &["experiments"]),
+];
+
+/// Where `module` stands in `layers`: its place in the order, and its layer's name.
+fn rank(layers: Layers, module: &str) -> Option<(usize, &'static str)> {
+    layers
         .iter()
         .flat_map(|(layer, modules)| modules.iter().map(move |m| (*m, *layer)))
         .enumerate()
@@ -40,7 +50,7 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
 }
 
 /// The top-level module a file of `src/` belongs to (`lod` for `src/lod/select.rs`), or
-/// `None` for `src/lib.rs`, the top, which puts the layers together.
+/// `None` for `lib.rs`, the top, which puts the layers together.
 fn module_of(src: &Path, file: &Path) -> Option<String> {
     let relative = file.strip_prefix(src).unwrap();
     let first = relative.components().next()?.as_os_str().to_str()?;
@@ -49,7 +59,7 @@ fn module_of(src: &Path, file: &Path) -> Option<String> {
 
 /// The modules a line of code names through `crate::` (in a path or a `use` group), and
 /// whether it names an item of the crate root itself.
-fn named_modules(code: &str) -> (BTreeSet<String>, bool) {
+fn named_modules(layers: Layers, code: &str) -> (BTreeSet<String>, bool) {
     let (mut modules, mut root) = (BTreeSet::new(), false);
     let mut rest = code;
     while let Some(at) = rest.find("crate::") {
@@ -62,7 +72,7 @@ fn named_modules(code: &str) -> (BTreeSet<String>, bool) {
         };
         for head in heads {
             let name: String = head.chars().take_while(|c| c.is_alphanumeric() || *c == '_').collect();
-            if rank(&name).is_some() || head[name.len()..].starts_with("::") {
+            if rank(layers, &name).is_some() || head[name.len()..].starts_with("::") {
                 modules.insert(name);
             } else if !name.is_empty() {
                 root = true;
@@ -72,17 +82,16 @@ fn named_modules(code: &str) -> (BTreeSet<String>, bool) {
     (modules, root)
 }
 
-#[test]
-fn each_core_module_imports_only_the_layers_below_it() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+/// Every import of the crate at `src` against `layers`: what goes against them.
+fn imports_against(src: &Path, layers: Layers) -> Vec<String> {
     let mut files = Vec::new();
-    rust_files(&src, &mut files);
+    rust_files(src, &mut files);
     files.sort();
     let mut wrong = Vec::new();
     let mut edges = BTreeSet::new();
     for file in &files {
-        let Some(module) = module_of(&src, file) else { continue };
-        let Some((own, own_layer)) = rank(&module) else {
+        let Some(module) = module_of(src, file) else { continue };
+        let Some((own, own_layer)) = rank(layers, &module) else {
             wrong.push(format!(
                 "{}: module `{module}` is in no layer of tests/it/layers.rs",
                 file.display()
@@ -92,7 +101,7 @@ fn each_core_module_imports_only_the_layers_below_it() {
         let text = std::fs::read_to_string(file).unwrap();
         for (n, line) in text.lines().enumerate() {
             let code = line.split("//").next().unwrap_or("");
-            let (modules, root) = named_modules(code);
+            let (modules, root) = named_modules(layers, code);
             let at = format!("{}:{}: `{}`", file.display(), n + 1, line.trim());
             if root {
                 wrong.push(format!(
@@ -101,7 +110,7 @@ fn each_core_module_imports_only_the_layers_below_it() {
             }
             for other in modules.into_iter().filter(|m| *m != module) {
                 edges.insert((module.clone(), other.clone()));
-                match rank(&other) {
+                match rank(layers, &other) {
                     Some((r, layer)) if r > own => wrong.push(format!(
                         "{at}: `{module}` ({own_layer}) imports `{other}` ({layer}), above it"
                     )),
@@ -116,19 +125,36 @@ fn each_core_module_imports_only_the_layers_below_it() {
             wrong.push(format!("`{a}` and `{b}` import each other"));
         }
     }
+    assert!(edges.len() >= layers.len(), "the check saw the imports: {edges:?}");
+    wrong
+}
+
+#[test]
+fn each_core_module_imports_only_the_layers_below_it() {
+    let wrong = imports_against(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), LAYERS);
     assert!(wrong.is_empty(), "imports against the layers:\n{}", wrong.join("\n"));
-    assert!(edges.len() > 10, "the check saw the imports: {edges:?}");
+}
+
+#[test]
+fn each_module_of_the_lab_imports_only_those_below_it() {
+    let lab = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/lab/src");
+    let wrong = imports_against(&lab, LAB_LAYERS);
+    assert!(
+        wrong.is_empty(),
+        "imports against the lab's layers:\n{}",
+        wrong.join("\n")
+    );
 }
 
 #[test]
 fn the_layer_check_reads_paths_and_groups() {
     assert_eq!(
-        named_modules("use crate::{contract::Lod, config::SimConfig};").0,
+        named_modules(LAYERS, "use crate::{contract::Lod, config::SimConfig};").0,
         BTreeSet::from(["config".to_owned(), "contract".to_owned()])
     );
-    assert!(named_modules("use crate::{SimClock, lod::Lod};").1);
+    assert!(named_modules(LAYERS, "use crate::{SimClock, lod::Lod};").1);
     assert_eq!(
-        named_modules(".after(crate::outcome::advance_clock)").0,
+        named_modules(LAYERS, ".after(crate::outcome::advance_clock)").0,
         BTreeSet::from(["outcome".to_owned()])
     );
 }

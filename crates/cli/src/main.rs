@@ -56,10 +56,9 @@ fn main() -> ExitCode {
         #[cfg(feature = "game")]
         None => PlayArgs::parse_from(["play"]).play(),
         #[cfg(not(feature = "game"))]
-        None => Err(
-            "this build has no game window (built without the `game` feature); `simlod run` simulates without one"
-                .to_owned(),
-        ),
+        None => Err(Failure::from(
+            "this build has no game window (built without the `game` feature); `simlod run` simulates without one",
+        )),
         #[cfg(feature = "game")]
         Some(Command::Play(args)) => args.play(),
         Some(Command::Run(args)) => args.run(),

@@ -5,6 +5,7 @@ use clap::Parser;
 use std::path::PathBuf;
 
 use crate::scenario::*;
+use simlod::config::Overrides;
 use simlod::lod::LevelPolicy;
 
 /// `Parser` too, so that `simlod` alone plays with the defaults.
@@ -45,8 +46,11 @@ impl PlayArgs {
         let played = simlod_game::play(simlod_game::PlayOptions {
             scenario: scenario_file(&self.assets, self.scenario.as_deref()),
             assets: self.assets,
-            policy: self.policy,
-            frame_budget_ms: self.frame_budget,
+            overrides: Overrides {
+                level_policy: self.policy,
+                frame_budget_ms: self.frame_budget,
+                ..Overrides::default()
+            },
             capture: self.frames.and_then(|frames| {
                 let (path, kind) = match (self.screenshot, self.record) {
                     (Some(path), _) => (path, simlod_game::Capture::Screenshot),

@@ -6,7 +6,7 @@ use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
 use std::path::{Path, PathBuf};
 
 use crate::run::*;
-use simlod::config::{MeasuredAnew, SimConfig, load_costs, load_file};
+use simlod::config::{MeasuredAnew, Overrides, SimConfig, load_costs, load_file};
 use simlod::lod::{LevelPolicy, Lod};
 
 #[derive(Args)]
@@ -124,32 +124,22 @@ impl ScenarioArgs {
     /// The scenario with its overrides, without what is about to be measured anew (see
     /// [`SimConfig::load_measuring`]).
     pub(crate) fn load_measuring(&self, anew: MeasuredAnew) -> Result<SimConfig, Failure> {
-        let mut config =
-            SimConfig::load_measuring(&self.scenario_file(), &self.assets, anew).map_err(|e| e.to_string())?;
+        let mut config = SimConfig::load_measuring(&self.scenario_file(), &self.assets, anew)?;
         if let Some(rules) = &self.rules {
-            config.rules = load_file(rules).map_err(|e| e.to_string())?;
+            config.rules = load_file(rules)?;
             if !anew.cost_model {
-                config.costs = load_costs(&self.assets, rules, &config.rules).map_err(|e| e.to_string())?;
+                config.costs = load_costs(&self.assets, rules, &config.rules)?;
             }
         }
-        if let Some(seed) = self.seed {
-            config.scenario.seed = seed;
+        Overrides {
+            seed: self.seed,
+            level_policy: self.policy,
+            puck_radius_m: self.puck_radius,
+            camera_radius_m: self.camera_radius,
+            frame_budget_ms: self.frame_budget,
+            solver_iterations: self.solver_iterations,
         }
-        if let Some(policy) = self.policy {
-            config.scenario.level_policy = policy;
-        }
-        if let Some(r) = self.puck_radius {
-            config.rules.influence.puck_radius_m = r;
-        }
-        if let Some(r) = self.camera_radius {
-            config.rules.camera.radius_m = r;
-        }
-        if let Some(ms) = self.frame_budget {
-            config.rules.budget.frame_budget_ms = ms;
-        }
-        if let Some(n) = self.solver_iterations {
-            config.scenario.solver_iterations = n;
-        }
+        .apply(&mut config);
         Ok(config)
     }
 }

@@ -22,8 +22,7 @@ use std::path::{Path, PathBuf};
 
 pub use capture::{Capture, CapturePlan};
 use simlod::SimPlugin;
-use simlod::config::{GameConfig, SimConfig, load_file};
-use simlod::lod::LevelPolicy;
+use simlod::config::{ConfigError, GameConfig, Overrides, SimConfig, load_file};
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {
@@ -31,11 +30,8 @@ pub struct PlayOptions {
     pub scenario: PathBuf,
     /// The assets folder (`--assets`), watched for edits.
     pub assets: PathBuf,
-    /// Overrides the scenario's level policy.
-    pub policy: Option<LevelPolicy>,
-    /// Overrides the budget policy's frame budget (ms of simulation per 1/30 s), until the
-    /// rules file is edited.
-    pub frame_budget_ms: Option<f32>,
+    /// What the command line changes of the scenario's files (the rules' until they are edited).
+    pub overrides: Overrides,
     /// Render some frames, save a screenshot or a recording of them, and quit.
     pub capture: Option<CapturePlan>,
 }
@@ -50,25 +46,37 @@ pub const GAME_FILE: &str = "game.ron";
 /// Said instead of a panic when there is no display to open a window on.
 pub const NO_DISPLAY: &str = "simlod cannot open the game window: no display is available (DISPLAY is not set or the X server cannot be reached); `simlod run` simulates without a window.";
 
+/// Why the game could not be played.
+#[derive(Debug, thiserror::Error)]
+pub enum GameError {
+    /// An asset file that did not load or did not pass its checks: it names the file and field.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// No display to open the window on.
+    #[error("{NO_DISPLAY}")]
+    NoDisplay,
+    /// What the game was asked does not fit its files: the message says how.
+    #[error("{0}")]
+    Invalid(String),
+    /// The game stopped with an error, which it logged.
+    #[error("the game stopped with an error (see above)")]
+    Stopped,
+}
+
 /// Opens the game window and plays until it closes.
-pub fn play(options: PlayOptions) -> Result<(), String> {
-    let mut config = SimConfig::load(&options.scenario, &options.assets).map_err(|e| e.to_string())?;
+pub fn play(options: PlayOptions) -> Result<(), GameError> {
+    let mut config = SimConfig::load(&options.scenario, &options.assets)?;
     let file_rules = config.rules.clone();
-    if let Some(policy) = options.policy {
-        config.scenario.level_policy = policy;
-    }
-    if let Some(ms) = options.frame_budget_ms {
-        config.rules.budget.frame_budget_ms = ms;
-    }
-    let looks: GameConfig = load_file(&options.assets.join(GAME_FILE)).map_err(|e| e.to_string())?;
+    options.overrides.apply(&mut config);
+    let looks: GameConfig = load_file(&options.assets.join(GAME_FILE))?;
     if let Some(plan) = &options.capture
         && plan.kind == Capture::Recording
         && plan.frames < looks.recording.every_nth_frame
     {
-        return Err(format!(
+        return Err(GameError::Invalid(format!(
             "--frames {} records no picture: {GAME_FILE}'s recording.every_nth_frame is {}",
             plan.frames, looks.recording.every_nth_frame
-        ));
+        )));
     }
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
     let mut app = App::new();
@@ -82,21 +90,25 @@ pub fn play(options: PlayOptions) -> Result<(), String> {
     }
     match app.run() {
         AppExit::Success => Ok(()),
-        AppExit::Error(_) => Err("the game stopped with an error (see above)".to_owned()),
+        AppExit::Error(_) => Err(GameError::Stopped),
     }
 }
 
 /// The scenario's path inside the assets folder, which is what the asset server watches.
-fn asset_path(assets: &Path, scenario: &Path) -> Result<String, String> {
+fn asset_path(assets: &Path, scenario: &Path) -> Result<String, GameError> {
     let (Ok(root), Ok(file)) = (assets.canonicalize(), scenario.canonicalize()) else {
-        return Err(format!("cannot find {} or {}", scenario.display(), assets.display()));
+        return Err(GameError::Invalid(format!(
+            "cannot find {} or {}",
+            scenario.display(),
+            assets.display()
+        )));
     };
     let inside = file.strip_prefix(&root).map_err(|_| {
-        format!(
+        GameError::Invalid(format!(
             "the scenario {} must be inside the assets folder {} (or give --assets)",
             scenario.display(),
             assets.display()
-        )
+        ))
     })?;
     Ok(inside.to_string_lossy().replace('\\', "/"))
 }
@@ -115,7 +127,7 @@ fn plain_when_piped(_: &mut App) -> Option<BoxedFmtLayer> {
 
 /// Bevy's plugins for a window. Building the window's event loop panics when there is no
 /// display; that panic is caught and told in one sentence.
-fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), String> {
+fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), GameError> {
     let plugins = DefaultPlugins
         .set(WindowPlugin {
             primary_window: Some(Window {
@@ -148,7 +160,7 @@ fn add_window_plugins(app: &mut App, options: &PlayOptions) -> Result<(), String
         app.add_plugins(plugins);
     }));
     std::panic::set_hook(quiet);
-    built.map_err(|_| NO_DISPLAY.to_owned())
+    built.map_err(|_| GameError::NoDisplay)
 }
 
 fn plugin(app: &mut App) {

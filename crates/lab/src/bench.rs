@@ -6,6 +6,7 @@
 //! nearby) stays what the game has. One frame is 1/30 s of motion (one steering decision's
 //! ticks). Figures are medians over frames, measured in one process.
 
+pub use crate::scene::scaled;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -39,29 +40,6 @@ pub struct LevelBench {
 
 fn level_name<S: serde::Serializer>(level: &Lod, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(level.name())
-}
-
-/// The scenario with `count` creatures of the same mix, in a court grown to the same density.
-/// A scenario of no creatures at all has no density: its first group gets them all, in the
-/// court as if the scenario had one.
-pub fn scaled(config: &SimConfig, count: u32, policy: LevelPolicy) -> SimConfig {
-    let mut c = config.clone();
-    let base = config.scenario.creature_count().max(1);
-    let mut left = count;
-    for (i, g) in c.scenario.creatures.iter_mut().enumerate().rev() {
-        g.count = if i == 0 {
-            left
-        } else {
-            (u64::from(g.count) * u64::from(count) / u64::from(base)) as u32
-        };
-        left -= g.count;
-    }
-    c.scenario.creatures.retain(|g| g.count > 0);
-    let grow = (count as f32 / base as f32).max(1.0).sqrt();
-    c.arena.court_length_m *= grow;
-    c.arena.court_width_m *= grow;
-    c.scenario.level_policy = policy;
-    c
 }
 
 /// The middle value (the upper one of an even count); `values` must not be empty.
@@ -290,7 +268,7 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let fixed_us = frame_us(config, 0, LevelPolicy::AllPointMass, 3 * runs, 5 * frames);
     let mut entries = Vec::new();
     for def in &config.kinds {
-        let alone = crate::experiments::only_kind(config, &def.name);
+        let alone = crate::scene::only_kind(config, &def.name);
         let levels = &kinds[config.kind_index(&def.name).expect("a kind of the config")].levels;
         let mut us = [0.0f64; 3];
         for &level in levels {

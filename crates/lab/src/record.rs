@@ -9,11 +9,11 @@
 //! speed measures the acceleration the point mass must match. The world is seeded, so the
 //! same files give the same table.
 
-use crate::LabError;
+use crate::error::LabError;
 use bevy::prelude::*;
 use std::fmt::Write as _;
 
-use crate::experiments::{EXPERIMENT_COURT_M, lone_creature, stand};
+use crate::scene::{EXPERIMENT_COURT_M, lone_creature, stand};
 use simlod::config::{CreatureDef, SimConfig};
 use simlod::creature::{DesiredVelocity, GaitPhase, PlanarState};
 use simlod::gait::{GaitPose, GaitRow, GaitTable, columns};

@@ -3,7 +3,7 @@
 //! few seconds with every frame's simulation timed: the mean and slowest frame, and the
 //! creatures at each level. A policy stops at the first size where a frame passes the limit.
 
-use crate::LabError;
+use crate::error::LabError;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
 use std::path::Path;
@@ -162,13 +162,13 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         let (name, colour) = (policy.name(), plot::policy_colour(policy));
         series.push(Series::new(
             format!("{name}, mean"),
-            curve(&name, |g| g.mean_frame_ms),
+            curve(name, |g| g.mean_frame_ms),
             Mark::Line,
             colour,
         ));
         series.push(Series::new(
             format!("{name}, slowest"),
-            curve(&name, |g| g.slowest_frame_ms),
+            curve(name, |g| g.slowest_frame_ms),
             Mark::Dashed,
             colour,
         ));

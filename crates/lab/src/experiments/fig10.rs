@@ -7,7 +7,7 @@
 //! Over 600 lines: the trials, the shards, resuming and merging all read and write the rows of
 //! one CSV file, kept in one place.
 
-use crate::{LabError, io_error};
+use crate::error::{LabError, io_error};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -306,7 +306,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         ..s
     };
     let out = &options.out;
-    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
+    std::fs::create_dir_all(out).map_err(io_error("create", out))?;
     let (done_path, partial_path) = (out.join("fig10.csv"), out.join("fig10.partial.csv"));
     let plan = plan_digest(config, &rules, &s);
     // What an earlier run of the same plan finished, whole trials only; a part made by another
@@ -436,7 +436,7 @@ fn same_plan(made_by: &str, version: &str, plan: &str, file: &Path) -> Result<()
 /// The rows of an unfinished run's journal. Its last line, cut short by the interruption
 /// (no line end), is a trial that did not finish: dropped, and the trial runs again.
 fn read_journal(path: &Path) -> Result<Vec<Row>, LabError> {
-    let text = std::fs::read_to_string(path).map_err(io_error("read", &path))?;
+    let text = std::fs::read_to_string(path).map_err(io_error("read", path))?;
     let whole = text.rfind('\n').map_or("", |end| &text[..=end]);
     if whole.len() < text.len() {
         eprintln!(
@@ -596,7 +596,7 @@ fn finish(
     smoke_test: bool,
     part: &PartOf,
 ) -> Result<String, LabError> {
-    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
+    std::fs::create_dir_all(out).map_err(io_error("create", out))?;
     rows.sort_by(|a, b| a.puck_radius_m.total_cmp(&b.puck_radius_m).then(a.trial.cmp(&b.trial)));
     let mut csv = format!("{HEADER}\n");
     for row in &rows {

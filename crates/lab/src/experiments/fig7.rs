@@ -2,7 +2,7 @@
 //! percentage of them that are rigid (the rest hybrid; no point masses, every creature in
 //! the game's steering and collisions). Levels are set by the experiment and held.
 
-use crate::LabError;
+use crate::error::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

@@ -3,7 +3,7 @@
 //! (figure 9: out of view point mass, in view hybrid, in view and near rigid). A frame is
 //! 1/30 s of motion; its rate is frames per second of wall time, headless.
 
-use crate::LabError;
+use crate::error::LabError;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

@@ -19,11 +19,8 @@ pub mod table1;
 
 pub use progress::Progress;
 
-/// The side of the square court the single-creature experiments and the gait recorder run
-/// in: room for a long run without meeting a wall.
-pub const EXPERIMENT_COURT_M: f32 = 300.0;
-
-use crate::{LabError, io_error};
+use crate::error::{LabError, io_error};
+pub use crate::scene::{EXPERIMENT_COURT_M, lone_creature, only_kind, stand};
 use bevy::prelude::*;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
@@ -33,9 +30,9 @@ use std::time::Instant;
 
 use simlod::SimStage;
 use simlod::config::{SimConfig, Validate, Validator, load_file};
-use simlod::creature::{Creature, DesiredVelocity, KindTable, PlanarState, PlayerControlled};
+use simlod::creature::KindTable;
 use simlod::headless::HeadlessSim;
-use simlod::lod::{LevelPolicy, Lod};
+use simlod::lod::Lod;
 use simlod::outcome::Summary;
 
 /// How an experiment is run: flags of `simlod experiment`.
@@ -163,15 +160,6 @@ fn lacking_level(config: &SimConfig, i: usize, levels: &[Lod]) -> Option<String>
     ))
 }
 
-/// The scenario with only creatures of `kind`, `count` of them.
-pub fn only_kind(config: &SimConfig, kind: &str) -> SimConfig {
-    let mut c = config.clone();
-    let count = c.scenario.creature_count();
-    c.scenario.creatures.retain(|g| g.kind == kind);
-    c.scenario.creatures[0].count = count;
-    c
-}
-
 /// Stops the rules and the stages that are not the models' own: levels stay as they are set,
 /// and `stages` (for example steering and collisions) do not run.
 pub fn hold_levels(sim: &mut HeadlessSim, stages: &[SimStage]) {
@@ -227,7 +215,7 @@ pub fn run_parallel<T: Sync, R: Send>(
 
 /// Writes one of an experiment's files into the output folder.
 pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, LabError> {
-    std::fs::create_dir_all(out).map_err(io_error("create", &out))?;
+    std::fs::create_dir_all(out).map_err(io_error("create", out))?;
     let path = out.join(file);
     std::fs::write(&path, text).map_err(io_error("write", &path))?;
     Ok(path)
@@ -309,51 +297,6 @@ pub fn median_of(values: impl IntoIterator<Item = f64>) -> f64 {
     } else {
         crate::bench::median(v)
     }
-}
-
-/// A world with one creature of `kind` at the level `policy` gives it, standing at `start`,
-/// steered from outside, the puck parked. The court is grown to `court_m` square so it can
-/// run for a while.
-pub fn lone_creature(
-    config: &SimConfig,
-    kind: &str,
-    policy: LevelPolicy,
-    start: Vec2,
-    court_m: f32,
-) -> (HeadlessSim, Entity) {
-    let mut config = config.clone();
-    config.scenario.creatures.retain(|g| g.kind == kind);
-    config.scenario.creatures[0].count = 1;
-    config.scenario.level_policy = policy;
-    config.arena.court_length_m = config.arena.court_length_m.max(court_m);
-    config.arena.court_width_m = config.arena.court_width_m.max(court_m);
-    // Parked: too slow to reach anyone during an experiment.
-    config.arena.puck.speed_m_per_s = 1e-3;
-    let mut sim = HeadlessSim::new(config);
-    let world = sim.app.world_mut();
-    let entity = world
-        .query_filtered::<Entity, With<Creature>>()
-        .single(world)
-        .expect("one creature");
-    world
-        .entity_mut(entity)
-        .insert((PlayerControlled, DesiredVelocity(Vec2::ZERO)));
-    stand(world, entity, start, None);
-    (sim, entity)
-}
-
-/// Moves a creature to `position` (and turns it to `heading`, if given) between ticks, and
-/// enters its level again there, so that its model (a rigid creature's bodies) stands there too.
-pub fn stand(world: &mut World, entity: Entity, position: Vec2, heading: Option<Vec2>) {
-    let mut e = world.entity_mut(entity);
-    let mut state = e.get_mut::<PlanarState>().expect("a creature has a planar state");
-    state.position = position;
-    if let Some(heading) = heading {
-        state.heading = heading;
-    }
-    let level = *e.get::<Lod>().expect("a creature has a level");
-    e.insert(level);
-    world.flush();
 }
 
 /// The command line that reruns experiment `name` as `options` ran it.

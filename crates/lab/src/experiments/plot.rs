@@ -3,7 +3,7 @@
 //!
 //! Over 600 lines with its unit tests, which check each kind of plot is drawn and not blank.
 
-use crate::LabError;
+use crate::error::LabError;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::Path;

@@ -1,7 +1,7 @@
 //! `report.md`: every experiment run into a folder, in the paper's order, each with its plot,
 //! what the paper reports, what we measured and how they compare (from each `<name>.json`).
 
-use crate::LabError;
+use crate::error::LabError;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

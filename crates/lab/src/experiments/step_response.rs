@@ -3,7 +3,7 @@
 //! 3.2: "even small differences in velocity can result in substantial changes in final
 //! position").
 
-use crate::LabError;
+use crate::error::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

@@ -3,7 +3,7 @@
 //! rendering: every creature runs at a set speed in its own direction), and, in a second
 //! column, the whole per-creature cost of a game (steering, level rules and collisions).
 
-use crate::LabError;
+use crate::error::LabError;
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;

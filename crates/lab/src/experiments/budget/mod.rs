@@ -20,7 +20,7 @@
 
 mod compare;
 
-use crate::LabError;
+use crate::error::LabError;
 use compare::{Against, Axis, Comparison, Measure, against_fixed, mean_sd_se};
 use serde::{Deserialize, Serialize};
 use std::fmt::Write as _;
