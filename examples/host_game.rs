@@ -12,7 +12,7 @@ use std::path::Path;
 
 use simlod::prelude::*;
 
-/// A body of the game's own: a crate dropped from above the court.
+/// A body of the game's own: a crate dropped from high above the court.
 #[derive(Component)]
 struct GameCrate;
 
@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         GameCrate,
         RigidBody::Dynamic,
         Collider::cuboid(0.5, 0.5, 0.5),
-        Transform::from_xyz(0.0, 20.0, 0.0),
+        Transform::from_xyz(0.0, 40.0, 0.0),
     ));
     // simlod finds rapier there and uses it; it leaves the game's executor as it is.
     app.add_plugins(SimPlugin::new(config.clone()).keep_host_executor());
@@ -51,9 +51,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     println!("after 2 s: the game's crate at {:.2} m", height(&mut app)?);
 
-    // A new round: simlod's creatures, court and puck are built again; the crate stays and falls on.
+    // A new round: simlod's creatures, court and puck are built again; the crate, still in the
+    // air, falls on and lands on the new court.
     start_over(app.world_mut(), config);
-    for _ in 0..30 {
+    for _ in 0..45 {
         app.update();
     }
     let world = app.world_mut();
@@ -61,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let creatures = world.query::<&Creature>().iter(world).count();
     let contexts = world.query::<&RapierContextSimulation>().iter(world).count();
     println!(
-        "after a new round and 1 s: the crate at {:.2} m; {creatures} creatures, {rigid} rigid; rapier worlds: {contexts}",
+        "after a new round and 1.5 s: the crate at {:.2} m; {creatures} creatures, {rigid} rigid; rapier worlds: {contexts}",
         height(&mut app)?
     );
     Ok(())

@@ -4,7 +4,8 @@
 //! (Graphics Interface '97). Legged creatures try to escape a giant puck in a walled court;
 //! each is simulated at a level of detail ([`lod::Lod`]) chosen per creature.
 //!
-//! The paper's pipeline is the layout. Once per simulation tick, in `FixedUpdate`:
+//! The paper's pipeline is the layout. Once per simulation tick, in `FixedUpdate` (or the
+//! schedule given to [`SimPlugin::in_schedule`]):
 //!
 //! | stage | module | what |
 //! |---|---|---|
@@ -13,9 +14,10 @@
 //! | [`SimStage::SelectLod`] | [`lod`] | the level each creature should be at: influence areas, camera rule |
 //! | [`SimStage::Switch`] | [`lod`] | a change of level, inside the flight-phase window |
 //! | [`SimStage::Step`] | [`models`] | the model of each creature's level |
-//! | rapier's `PhysicsSet`s | [`arena`] | the puck and walls (rapier bodies) |
+//! | rapier's `PhysicsSet`s | [`third_party`] | the puck, the walls and the rigid creatures (rapier bodies) |
 //! | [`SimStage::Observe`] | [`outcome`] | collisions with the puck, walls and other creatures |
-//! | [`SimStage::Outcome`] | [`outcome`] | fallen creatures removed and respawned; the clock |
+//! | [`SimStage::Outcome`] | [`outcome`], [`lod`] | fallen creatures removed and respawned; what is drawn across a switch |
+//! | [`SimStage::Clock`] | [`outcome`] | the tick ends: the clock moves on |
 //!
 //! # Where to start
 //!

@@ -28,7 +28,9 @@ use crate::{arena, creature, lod, models, outcome, sense, third_party};
 ///   of the others on small machines (its loops over creatures still use every core);
 ///   [`SimPlugin::keep_host_executor`] leaves yours.
 ///
-/// Everything it spawns carries [`SimEntity`]; its resources are its own types.
+/// Everything it spawns carries [`SimEntity`]. Of what the app already has, it sets `Time<Fixed>`
+/// (in `FixedUpdate`), rapier's `TimestepMode` and solver parameters, and, unless told to keep
+/// it, its schedule's executor.
 pub struct SimPlugin {
     /// The scenario, loaded and checked, with every file it names.
     pub config: SimConfig,
