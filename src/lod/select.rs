@@ -266,15 +266,16 @@ impl LevelInputs<'_> {
             r.puck + self.puck.radius_m,
             la,
         );
-        let in_area =
-            || (self.areas.iter()).any(|a| in_influence(s.position, a.position, a.velocity, a.radius_m + r.grow, la));
+        // The host's areas only where the puck and walls have not decided already.
+        let in_area = !(near_wall || in_puck)
+            && (self.areas.iter()).any(|a| in_influence(s.position, a.position, a.velocity, a.radius_m + r.grow, la));
         let mut in_creature = false;
-        if !(near_wall || in_puck || in_area()) {
+        if !(near_wall || in_puck || in_area) {
             self.grid.for_each_within(s.position, self.reach_m + r.creature, |n| {
                 in_creature |= n.serial != c.serial && in_influence(s.position, n.position, n.velocity, r.creature, la);
             });
         }
-        if near_wall || in_puck || in_creature || in_area() {
+        if near_wall || in_puck || in_area || in_creature {
             Lod::Rigid
         } else {
             Lod::Hybrid
