@@ -197,10 +197,52 @@ impl GaitTable {
     /// [`crate::creature::GaitPhase::stride`]): each column interpolated in phase within the
     /// two rows around `speed`, then in speed between them.
     pub fn pose(&self, speed: f32, stride: f32) -> GaitPose {
-        let (a, b, t) = bracket(&self.rows, speed);
-        let steps = self.steps_per_stride;
-        let (a0, a1, ta) = a.samples_at(stride, steps, self.sample_hz);
-        let (b0, b1, tb) = b.samples_at(stride, steps, self.sample_hz);
+        self.at(speed).pose(stride)
+    }
+
+    /// Hop period and stance share at `speed`.
+    pub fn rhythm(&self, speed: f32) -> (f32, f32) {
+        self.at(speed).rhythm()
+    }
+
+    /// The table at `speed`: the rows around it, found once for both its rhythm and its pose.
+    pub fn at(&self, speed: f32) -> AtSpeed<'_> {
+        let (lower, upper, t) = bracket(&self.rows, speed);
+        AtSpeed {
+            table: self,
+            lower,
+            upper,
+            t,
+        }
+    }
+}
+
+/// A gait table at one speed: the two rows around it and the weight of the upper.
+#[derive(Clone, Copy, Debug)]
+pub struct AtSpeed<'a> {
+    table: &'a GaitTable,
+    lower: &'a GaitRow,
+    upper: &'a GaitRow,
+    t: f32,
+}
+
+impl AtSpeed<'_> {
+    /// Hop period and stance share.
+    pub fn rhythm(&self) -> (f32, f32) {
+        let (a, b, t) = (self.lower, self.upper, self.t);
+        (
+            a.hop_period_s + (b.hop_period_s - a.hop_period_s) * t,
+            a.stance_fraction + (b.stance_fraction - a.stance_fraction) * t,
+        )
+    }
+
+    /// The pose at `stride` phase: each column interpolated in phase within the two rows, then
+    /// in speed between them.
+    pub fn pose(&self, stride: f32) -> GaitPose {
+        let (a, b, t) = (self.lower, self.upper, self.t);
+        let (steps, hz) = (self.table.steps_per_stride, self.table.sample_hz);
+        let (a0, a1, ta) = a.samples_at(stride, steps, hz);
+        let (b0, b1, tb) = b.samples_at(stride, steps, hz);
         let mut row = [0.0; BODY_COLUMNS.len() + LEG_COLUMNS.len() * MAX_LEGS];
         let columns = a0.len().min(row.len());
         let samples = a0.iter().zip(a1).zip(b0.iter().zip(b1));
@@ -210,14 +252,5 @@ impl GaitTable {
             *value = at_a + (at_b - at_a) * t;
         }
         GaitPose::from_row(&row[..columns])
-    }
-
-    /// Hop period and stance share at `speed`.
-    pub fn rhythm(&self, speed: f32) -> (f32, f32) {
-        let (a, b, t) = bracket(&self.rows, speed);
-        (
-            a.hop_period_s + (b.hop_period_s - a.hop_period_s) * t,
-            a.stance_fraction + (b.stance_fraction - a.stance_fraction) * t,
-        )
     }
 }

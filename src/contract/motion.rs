@@ -64,14 +64,22 @@ impl GaitPhase {
         }
     }
 
-    /// Advances the cycle by `dt` from `now_s` at the given rhythm: stance first, then flight;
-    /// a touchdown starts the next of `steps_per_stride` steps.
-    pub fn advance(&mut self, hop_period_s: f32, stance_fraction: f32, steps_per_stride: u32, now_s: f32, dt: f32) {
-        let cycle = self.cycle + dt / hop_period_s;
-        *self = if cycle >= 1.0 {
+    /// The gait `cycles` cycles on at the given rhythm, `end_s` the simulated time it is then:
+    /// stance first, then flight; each touchdown starts the next of `steps_per_stride` steps.
+    pub fn advanced(
+        &self,
+        cycles: f32,
+        hop_period_s: f32,
+        stance_fraction: f32,
+        steps_per_stride: u32,
+        end_s: f32,
+    ) -> Self {
+        let cycle = self.cycle + cycles;
+        if cycle >= 1.0 {
+            let touchdowns = cycle.floor();
             Self {
-                step: ((u32::from(self.step) + 1) % steps_per_stride.max(1)) as u8,
-                ..Self::at(cycle.fract(), hop_period_s, stance_fraction, now_s + dt)
+                step: ((u32::from(self.step) + touchdowns as u32) % steps_per_stride.max(1)) as u8,
+                ..Self::at(cycle - touchdowns, hop_period_s, stance_fraction, end_s)
             }
         } else {
             Self {
@@ -81,7 +89,7 @@ impl GaitPhase {
                 stance_fraction,
                 ..*self
             }
-        };
+        }
     }
 
     /// How far through the stride (0..1 from the first leg's touchdown): the gait table's phase.

@@ -1,6 +1,7 @@
 //! Creatures: the components every level of detail shares, spawning and respawning.
 
 pub mod steering;
+pub use steering::Clearance;
 
 pub use crate::contract::{DesiredVelocity, GaitPhase, PlanarState, PlayerControlled};
 pub use crate::kind::{Creature, KindParams, KindTable, VirtualLegs, starting_gait};

@@ -51,8 +51,24 @@ pub struct Surroundings<'a> {
     pub decision_dt: f32,
 }
 
-/// The velocity a creature wants, given where it is and what is around it.
-pub fn desired_velocity(creature: &Creature, state: &PlanarState, kind: &KindParams, around: &Surroundings) -> Vec2 {
+/// How far from a creature, at its last decision, no other creature's centre was: what steering
+/// saw of its neighbours as it kept apart from them, looking as far as its separation distance
+/// (0 where it did not look). The contact check between creatures need not search again
+/// where this is wider than any contact the creature could make before it is checked.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct Clearance {
+    /// Metres between the creature's centre and the nearest other centre, or how far it looked.
+    pub clear_m: f32,
+}
+
+/// The velocity a creature wants, given where it is and what is around it; and its
+/// [`Clearance`] there.
+pub fn desired_velocity(
+    creature: &Creature,
+    state: &PlanarState,
+    kind: &KindParams,
+    around: &Surroundings,
+) -> (Vec2, Clearance) {
     let s = &kind.steering;
     let p = state.position;
     let top = kind.top_speed_m_per_s;
@@ -77,12 +93,14 @@ pub fn desired_velocity(creature: &Creature, state: &PlanarState, kind: &KindPar
     }
 
     // Keep apart from neighbours.
+    let mut clear_m = s.separation_distance_m;
     if s.separation_distance_m > 0.0 {
         let mut push = Vec2::ZERO;
         around.grid.for_each_within(p, s.separation_distance_m, |n| {
             if n.serial != creature.serial {
                 let d = p - n.position;
                 let len = d.length();
+                clear_m = clear_m.min(len);
                 if len > 1e-4 {
                     push += d / len * (1.0 - len / s.separation_distance_m);
                 }
@@ -109,7 +127,7 @@ pub fn desired_velocity(creature: &Creature, state: &PlanarState, kind: &KindPar
         }
     }
 
-    desired.clamp_length_max(top)
+    (desired.clamp_length_max(top), Clearance { clear_m })
 }
 
 fn steer(
@@ -119,7 +137,7 @@ fn steer(
     puck: Res<PuckState>,
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
-    mut creatures: Query<(&Creature, &PlanarState, &mut DesiredVelocity), Without<PlayerControlled>>,
+    mut creatures: Query<(&Creature, &PlanarState, &mut DesiredVelocity, &mut Clearance), Without<PlayerControlled>>,
 ) {
     if !clock.is_decision_tick() {
         return;
@@ -132,16 +150,17 @@ fn steer(
         decision: clock.decision(),
         decision_dt: clock.dt * clock.ticks_per_decision as f32,
     };
-    let steer_one = |creature: &Creature, state: &PlanarState, desired: &mut DesiredVelocity| {
-        desired.0 = desired_velocity(creature, state, &kinds[creature.kind], &around);
+    let steer_one = |creature: &Creature, state: &PlanarState, desired: &mut DesiredVelocity, clear: &mut Clearance| {
+        (desired.0, *clear) = desired_velocity(creature, state, &kinds[creature.kind], &around);
     };
-    for (creature, state, mut desired) in creatures.contiguous_iter_mut().expect(DENSE) {
+    for (creature, state, mut desired, mut clear) in creatures.contiguous_iter_mut().expect(DENSE) {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
-        let chunks = (creature.chunks(n).zip(state.chunks(n))).zip(desired.bypass_change_detection().chunks_mut(n));
-        run_chunks(chunks.map(|((c, s), d)| {
+        let (desired, clear) = (desired.bypass_change_detection(), clear.bypass_change_detection());
+        let chunks = (creature.chunks(n).zip(state.chunks(n))).zip(desired.chunks_mut(n).zip(clear.chunks_mut(n)));
+        run_chunks(chunks.map(|((c, s), (d, cl))| {
             move || {
-                for ((c, s), d) in c.iter().zip(s).zip(d) {
-                    steer_one(c, s, d);
+                for ((c, s), (d, cl)) in c.iter().zip(s).zip(d.iter_mut().zip(cl)) {
+                    steer_one(c, s, d, cl);
                 }
             }
         }));
@@ -150,7 +169,8 @@ fn steer(
 
 pub(super) fn plugin(app: &mut App) {
     let schedule = SimClock::schedule_of(app);
-    app.add_systems(schedule, steer.in_set(SimStage::Steer));
+    app.register_required_components::<Creature, Clearance>()
+        .add_systems(schedule, steer.in_set(SimStage::Steer));
 }
 
 #[cfg(test)]

@@ -2,12 +2,19 @@
 //! with an acceleration limit and a top speed; the body faces its direction of travel; the
 //! leg is held at a constant angle (the kind's standing pose), so there is nothing of it to
 //! compute. The hybrid level (3.2) is this same model plus the gait table.
+//!
+//! Between two steering decisions the desired velocity holds, so the motion is known in
+//! closed form: the velocity moves straight toward its target at the acceleration limit, the
+//! position is the sum of the ticks' velocities, the gait's cycle runs at its rhythm. A
+//! creature's state at any tick is worked out from where its stretch of motion began
+//! ([`PlanarSegment`]), in one step however many ticks have passed: stepped a tick at a time or
+//! a frame at once ([`FrameStep`]), it holds the same bits at every tick something reads.
 
 use bevy::prelude::*;
 
 use super::hybrid;
 use crate::config::SimConfig;
-use crate::config::gait::GaitTable;
+use crate::config::gait::{AtSpeed, GaitTable};
 use crate::contract::GaitPose;
 use crate::contract::{AtPointMass, AtRigid, Lod};
 use crate::contract::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
@@ -17,8 +24,8 @@ use crate::kind::{Creature, KindParams, KindTable};
 /// Below this speed the heading is left where it was (no spinning in place).
 const HEADING_MIN_SPEED_M_PER_S: f32 = 0.05;
 
-/// The most a body of a kind turns in one tick, as its cosine and the rotations either way:
-/// the same for every creature of the kind, so worked out once a tick, not once a creature.
+/// The most a body of a kind turns in some number of ticks, as its cosine and the rotations
+/// either way: the same for every creature of the kind, so worked out once, not once a creature.
 #[derive(Clone, Copy, Debug)]
 pub struct TurnLimit {
     cos: f32,
@@ -27,56 +34,117 @@ pub struct TurnLimit {
 }
 
 impl TurnLimit {
-    /// The turn a creature of `kind` may make in a tick of `dt` seconds.
-    pub fn new(kind: &KindParams, dt: f32) -> Self {
-        let max_turn = kind.turn_rate_rad_per_s * dt;
+    /// The turn a creature of `kind` may make in `seconds`.
+    pub fn new(kind: &KindParams, seconds: f32) -> Self {
+        let max_turn = (kind.turn_rate_rad_per_s * seconds).abs();
         Self {
-            cos: max_turn.cos(),
-            left: Vec2::from_angle(max_turn.abs()),
-            right: Vec2::from_angle(-max_turn.abs()),
-        }
-    }
-}
-
-/// One tick of the planar point mass: velocity moves toward the desired one, clipped to the
-/// top speed, by at most the acceleration limit. A body faster than its top speed (shoved,
-/// or just switched from the rigid level) slows at the limit: no pop in velocity. Returns
-/// whether the body is steady: at the velocity it wants and facing its travel, so that the
-/// next tick at the same desired velocity only moves it on.
-pub fn step_planar(state: &mut PlanarState, desired: Vec2, kind: &KindParams, turn: &TurnLimit, dt: f32) -> bool {
-    let target = desired.clamp_length_max(kind.top_speed_m_per_s);
-    state.velocity += (target - state.velocity).clamp_length_max(kind.acceleration_limit_m_per_s2 * dt);
-    state.position += state.velocity * dt;
-    let speed = state.velocity.length();
-    let mut facing = true;
-    if speed > HEADING_MIN_SPEED_M_PER_S {
-        // Turn toward the direction of travel at the turn rate: no pop when the body came
-        // from a level that faced elsewhere.
-        let travel = state.velocity / speed;
-        state.heading = if state.heading.dot(travel) >= turn.cos {
-            travel
-        } else {
-            facing = false;
-            if state.heading.perp_dot(travel).is_sign_negative() {
-                turn.right.rotate(state.heading)
+            // Half a turn or more reaches any direction (a cosine never below -1 says so).
+            cos: if max_turn >= std::f32::consts::PI {
+                -2.0
             } else {
-                turn.left.rotate(state.heading)
-            }
-        };
+                max_turn.cos()
+            },
+            left: Vec2::from_angle(max_turn),
+            right: Vec2::from_angle(-max_turn),
+        }
     }
-    facing && state.velocity == target
 }
 
-/// The hop cycle's rhythm at a level: the step's period and its part on the ground, and the
-/// steps in a stride. A hybrid's comes from its table at its speed; a point mass keeps its
-/// kind's own ("holds the leg at a constant angle", 3.3).
-fn rhythm(kind: &KindParams, table: Option<&GaitTable>, velocity: Vec2) -> (f32, f32, u32) {
-    match table {
-        Some(table) => {
-            let (period, stance) = table.rhythm(velocity.length());
-            (period, stance, table.steps_per_stride)
+/// The planar point mass `ticks` ticks of `dt` on from `start` toward `desired`. The target is
+/// the desired velocity within the top speed; the velocity moves straight toward it by the
+/// acceleration limit each tick until it is there (a body faster than its top speed, shoved or
+/// just switched from the rigid level, slows at the limit: no pop in velocity), so each tick's
+/// velocity, and their sum, the way travelled, are known without stepping the ticks. The body
+/// turns toward its travel by at most `turn` (the turn rate over those ticks): no pop when it
+/// came from a level that faced elsewhere.
+pub fn planar_after(
+    start: &PlanarState,
+    desired: Vec2,
+    kind: &KindParams,
+    turn: &TurnLimit,
+    ticks: u32,
+    dt: f32,
+) -> PlanarState {
+    let target = desired.clamp_length_max(kind.top_speed_m_per_s);
+    let gap = target - start.velocity;
+    let gap_m_per_s = gap.length();
+    let per_tick = kind.acceleration_limit_m_per_s2 * dt;
+    let k = ticks as f32;
+    let (velocity, velocity_sum) = if gap_m_per_s > 0.0 {
+        let toward = gap / gap_m_per_s;
+        // Ticks that gain the whole limit; the target is reached on the tick after them.
+        let full = ((gap_m_per_s / per_tick) as u32).min(ticks) as f32;
+        let gained = per_tick * full * (full + 1.0) * 0.5 + (k - full) * gap_m_per_s;
+        let velocity = if full < k {
+            target
+        } else {
+            start.velocity + toward * (per_tick * k)
+        };
+        (velocity, start.velocity * k + toward * gained)
+    } else {
+        (start.velocity, start.velocity * k)
+    };
+    let speed = velocity.length();
+    let heading = if speed > HEADING_MIN_SPEED_M_PER_S {
+        let travel = velocity / speed;
+        if start.heading.dot(travel) >= turn.cos {
+            travel
+        } else if start.heading.perp_dot(travel).is_sign_negative() {
+            turn.right.rotate(start.heading)
+        } else {
+            turn.left.rotate(start.heading)
         }
-        None => (1.0 / kind.cycles_per_s, kind.stance_fraction, kind.steps_per_stride()),
+    } else {
+        start.heading
+    };
+    PlanarState {
+        position: start.position + velocity_sum * dt,
+        velocity,
+        heading,
+    }
+}
+
+/// The hop cycle's rhythm at the end of a stretch: the step's period and its part on the
+/// ground, and the steps in a stride.
+#[derive(Clone, Copy, Debug)]
+struct Rhythm {
+    period_s: f32,
+    stance: f32,
+    steps: u32,
+}
+
+impl Rhythm {
+    /// A point mass keeps its kind's own ("holds the leg at a constant angle", 3.3).
+    fn of_kind(kind: &KindParams) -> Self {
+        Self {
+            period_s: 1.0 / kind.cycles_per_s,
+            stance: kind.stance_fraction,
+            steps: kind.steps_per_stride(),
+        }
+    }
+
+    /// A hybrid's comes from its table at its speed.
+    fn of_table(table: &GaitTable, at: &AtSpeed) -> Self {
+        let (period_s, stance) = at.rhythm();
+        Self {
+            period_s,
+            stance,
+            steps: table.steps_per_stride,
+        }
+    }
+
+    /// The gait `seconds` on from `start`; `end_s` is the simulated time then. The cycle runs at
+    /// the mean of the rate it had and this one (the table's hop period changes little with
+    /// speed, "the running frequency is nearly independent of forward velocity"; from the rigid
+    /// level, the rigid hop's).
+    fn advance(&self, start: &GaitPhase, seconds: f32, end_s: f32) -> GaitPhase {
+        let rate = 1.0 / self.period_s;
+        let rate = if start.hop_period_s > 0.0 {
+            0.5 * (1.0 / start.hop_period_s + rate)
+        } else {
+            rate
+        };
+        start.advanced(seconds * rate, self.period_s, self.stance, self.steps, end_s)
     }
 }
 
@@ -93,12 +161,11 @@ fn enter_point_mass(
 }
 
 /// Whether a planar creature is behind its frame. A creature that nothing reads between two
-/// steering decisions (far from the puck and the walls, not waiting to switch, not steered
-/// by a player: decided with the contacts at each decision) keeps the decision's state while
-/// the frame's ticks go by, and is stepped through all of them at once at the frame's last
-/// tick, or as soon as something needs it sooner. It is the same arithmetic in the same
-/// order, so the same state bit for bit; a crowd's frame was spent moving every creature's
-/// components through memory once a tick, and this moves them once a frame.
+/// steering decisions (far from the puck and the walls, not waiting to switch, not steered by
+/// a player: decided with the contacts at each decision) keeps the state of its decision's tick
+/// while the frame's ticks go by, and is moved on to the frame's last tick in one step at that
+/// tick, or as soon as something needs it sooner: the same closed form from the same start as
+/// a tick at a time, so the same state bit for bit, for one pass over a crowd a frame.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStep {
     /// Holds the state of its frame's decision tick: the frame's ticks since are still to step.
@@ -115,27 +182,74 @@ pub struct FrameStepping {
     pub enabled: bool,
 }
 
-/// Steps planar creatures: what a tick of each kind needs, worked out once a tick.
+/// Where a planar creature's current stretch of motion began: the state and gait it started
+/// from, the tick that state is of, and the velocity and level it moves at; and what was worked
+/// out from it last. A stretch begins on the tick after each decision, and again wherever
+/// anything else has written the state since (a collision, a switch, a player's new velocity):
+/// each tick's state is worked out from the stretch's start, not from the tick before.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub struct PlanarSegment {
+    start: PlanarState,
+    start_gait: GaitPhase,
+    /// The tick at whose end `start` is.
+    tick: u64,
+    desired: Vec2,
+    lod: Lod,
+    published: PlanarState,
+    published_gait: GaitPhase,
+}
+
+impl PlanarSegment {
+    /// A stretch starting from the creature as it is, at the end of tick `tick`.
+    fn begin(state: &PlanarState, gait: &GaitPhase, desired: Vec2, lod: Lod, tick: u64) -> Self {
+        Self {
+            start: *state,
+            start_gait: *gait,
+            tick,
+            desired,
+            lod,
+            published: *state,
+            published_gait: *gait,
+        }
+    }
+
+    /// Whether the creature is still on this stretch: nothing but the stepper moved it.
+    fn holds(&self, state: &PlanarState, gait: &GaitPhase, desired: Vec2, lod: Lod) -> bool {
+        self.published == *state && self.published_gait == *gait && self.desired == desired && self.lod == lod
+    }
+}
+
+/// Works out planar creatures' states: what each kind needs, once per system run.
 pub struct PlanarStepper<'a> {
     kinds: &'a KindTable,
-    turns: Vec<TurnLimit>,
+    /// Each kind's turn limit over 1, 2, ... ticks, up to a decision's, and its point mass's rhythm.
+    per_kind: Vec<(Vec<TurnLimit>, Rhythm)>,
     clock: SimClock,
+    /// Simulated time at the end of this tick.
+    end_s: f32,
 }
 
 impl<'a> PlanarStepper<'a> {
     /// A stepper for the tick `clock` is at.
     pub fn new(kinds: &'a KindTable, clock: &SimClock) -> Self {
+        let ticks = clock.ticks_per_decision.max(1);
         Self {
             kinds,
-            turns: kinds.0.iter().map(|k| TurnLimit::new(k, clock.dt)).collect(),
+            per_kind: (kinds.0.iter())
+                .map(|k| {
+                    let turns = (1..=ticks).map(|n| TurnLimit::new(k, n as f32 * clock.dt)).collect();
+                    (turns, Rhythm::of_kind(k))
+                })
+                .collect(),
             clock: *clock,
+            end_s: clock.seconds_at(clock.tick + 1) as f32,
         }
     }
 
-    /// Steps one creature through the last `ticks` ticks up to and including this one, at its
-    /// desired velocity: the plane, the gait's rhythm, and (for a hybrid) the pose at the end,
-    /// which depends on the speed and the gait's place alone.
-    pub fn step(
+    /// Moves one creature from the state and gait it holds, `ticks` ticks before the end of
+    /// this tick, to the end of this tick at its desired velocity: the plane, the gait's
+    /// rhythm, and (for a hybrid) the pose, which depends on the speed and the gait's place alone.
+    pub fn advance(
         &self,
         creature: &Creature,
         lod: Lod,
@@ -146,52 +260,91 @@ impl<'a> PlanarStepper<'a> {
         ticks: u64,
     ) {
         let kind = &self.kinds[creature.kind];
-        let (turn, dt) = (&self.turns[creature.kind], self.clock.dt);
         let table = match (lod, &kind.gait) {
             (Lod::Hybrid, Some(table)) => Some(table),
             // A hybrid whose kind has no table is not made: `KindParams::best_level`.
             (Lod::Hybrid, None) => return,
             _ => None,
         };
-        // Once steady, a tick only moves the body on and the gait along at a rhythm that no
-        // longer changes: the same arithmetic as a whole tick, without what comes out the same.
-        let mut steady = None;
-        for tick in self.clock.tick + 1 - ticks..=self.clock.tick {
-            let (period, stance, steps) = match steady {
-                Some(rhythm) => {
-                    state.position += state.velocity * dt;
-                    rhythm
-                }
-                None => {
-                    let now_steady = step_planar(state, desired, kind, turn, dt);
-                    let rhythm = rhythm(kind, table, state.velocity);
-                    steady = now_steady.then_some(rhythm);
-                    rhythm
-                }
-            };
-            gait.advance(period, stance, steps, self.clock.seconds_at(tick) as f32, dt);
+        let (turns, point_mass) = &self.per_kind[creature.kind];
+        // A stretch ends at the next decision: never more ticks than a decision's.
+        debug_assert!((1..=turns.len() as u64).contains(&ticks), "{ticks} ticks");
+        let ticks = ticks.clamp(1, turns.len() as u64) as u32;
+        *state = planar_after(state, desired, kind, &turns[ticks as usize - 1], ticks, self.clock.dt);
+        let seconds = ticks as f32 * self.clock.dt;
+        match table {
+            Some(table) => {
+                let at = table.at(state.velocity.length());
+                *gait = Rhythm::of_table(table, &at).advance(gait, seconds, self.end_s);
+                *pose = hybrid::pose(gait, &at, table.steps_per_stride);
+            }
+            None => *gait = point_mass.advance(gait, seconds, self.end_s),
         }
-        if let Some(table) = table {
-            *pose = hybrid::pose(gait, table, state.velocity.length());
+    }
+
+    /// Moves a creature on its stretch to the end of this tick, beginning a new stretch from where
+    /// it is if it has left the one it was on (or `fresh`: the first tick after a decision).
+    #[allow(clippy::too_many_arguments)]
+    pub fn follow(
+        &self,
+        creature: &Creature,
+        lod: Lod,
+        desired: Vec2,
+        state: &mut PlanarState,
+        gait: &mut GaitPhase,
+        pose: &mut GaitPose,
+        segment: &mut PlanarSegment,
+        fresh: bool,
+    ) {
+        if fresh || !segment.holds(state, gait, desired, lod) {
+            *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - 1);
         }
+        (*state, *gait) = (segment.start, segment.start_gait);
+        self.advance(
+            creature,
+            lod,
+            desired,
+            state,
+            gait,
+            pose,
+            self.clock.tick - segment.tick,
+        );
+        (segment.published, segment.published_gait) = (*state, *gait);
+    }
+
+    /// Catches up a creature behind its frame, `ticks` ticks after its decision's tick, as if it
+    /// had followed its stretch a tick at a time.
+    #[allow(clippy::too_many_arguments)]
+    pub fn catch_up(
+        &self,
+        creature: &Creature,
+        lod: Lod,
+        desired: Vec2,
+        state: &mut PlanarState,
+        gait: &mut GaitPhase,
+        pose: &mut GaitPose,
+        segment: &mut PlanarSegment,
+        ticks: u64,
+    ) {
+        *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - ticks);
+        self.advance(creature, lod, desired, state, gait, pose, ticks);
+        (segment.published, segment.published_gait) = (*state, *gait);
     }
 }
 
 /// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
-/// A creature behind its frame waits for the frame's last tick.
+/// On a decision's tick every creature moves one tick from where it is (the new desired
+/// velocity starts there); after it, each follows its stretch, and a creature behind its frame
+/// waits for the frame's last tick.
 fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
     mut creatures: Query<
         (
-            &Creature,
-            &Lod,
-            &DesiredVelocity,
-            &mut PlanarState,
-            &mut GaitPhase,
-            &mut GaitPose,
-            &mut FrameStep,
+            (&Creature, &Lod, &DesiredVelocity),
+            (&mut PlanarState, &mut GaitPhase, &mut GaitPose),
+            (&mut FrameStep, &mut PlanarSegment),
         ),
         Without<AtRigid>,
     >,
@@ -201,38 +354,40 @@ fn step_point_masses(
     let last_of_frame = in_frame + 1 == u64::from(clock.ticks_per_decision);
     let step = |creature: &Creature,
                 lod: Lod,
-                desired: &DesiredVelocity,
-                state: &mut PlanarState,
-                gait: &mut GaitPhase,
-                pose: &mut GaitPose,
-                frame: &mut FrameStep| {
-        let ticks = match (frame.behind, last_of_frame) {
-            (false, _) => 1,
-            (true, false) => return,
-            (true, true) => {
+                desired: Vec2,
+                (state, gait, pose): (&mut PlanarState, &mut GaitPhase, &mut GaitPose),
+                frame: &mut FrameStep,
+                segment: &mut PlanarSegment| {
+        match (frame.behind, in_frame) {
+            (true, _) if !last_of_frame => {}
+            (true, _) => {
                 frame.behind = false;
-                in_frame
+                stepper.advance(creature, lod, desired, state, gait, pose, in_frame);
             }
-        };
-        stepper.step(creature, lod, desired.0, state, gait, pose, ticks);
+            (false, 0) => stepper.advance(creature, lod, desired, state, gait, pose, 1),
+            (false, _) => stepper.follow(creature, lod, desired, state, gait, pose, segment, in_frame == 1),
+        }
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
     // of each creature's components one by one cost more than the step itself.
-    for (creature, lod, desired, mut state, mut gait, mut pose, mut frame) in
+    for ((creature, lod, desired), (mut state, mut gait, mut pose), (mut frame, mut segment)) in
         creatures.contiguous_iter_mut().expect(DENSE)
     {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         // Nothing watches these components' change ticks: writing them is a pass of its own.
         let (state, gait) = (state.bypass_change_detection(), gait.bypass_change_detection());
         let (pose, frame) = (pose.bypass_change_detection(), frame.bypass_change_detection());
+        let segment = segment.bypass_change_detection();
         let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
-            .zip((state.chunks_mut(n).zip(gait.chunks_mut(n))).zip(pose.chunks_mut(n).zip(frame.chunks_mut(n))));
-        run_chunks(chunks.map(|(((c, l), d), ((s, g), (p, f)))| {
+            .zip((state.chunks_mut(n).zip(gait.chunks_mut(n))).zip(pose.chunks_mut(n)))
+            .zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)));
+        run_chunks(chunks.map(|((((c, l), d), ((s, g), p)), (f, seg))| {
             move || {
-                for (((c, l), d), ((s, g), (p, f))) in
-                    (c.iter().zip(l).zip(d)).zip((s.iter_mut().zip(g)).zip(p.iter_mut().zip(f)))
-                {
-                    step(c, *l, d, s, g, p, f);
+                let rows = (c.iter().zip(l).zip(d))
+                    .zip((s.iter_mut().zip(g)).zip(p.iter_mut()))
+                    .zip(f.iter_mut().zip(seg));
+                for ((((c, l), d), ((s, g), p)), (f, seg)) in rows {
+                    step(c, *l, d.0, (s, g, p), f, seg);
                 }
             }
         }));
@@ -242,6 +397,7 @@ fn step_point_masses(
 pub(super) fn plugin(app: &mut App) {
     let schedule = SimClock::schedule_of(app);
     app.register_required_components::<Creature, FrameStep>()
+        .register_required_components::<Creature, PlanarSegment>()
         .add_observer(enter_point_mass)
         .add_systems(schedule, step_point_masses.in_set(SimStage::Step));
 }
@@ -287,53 +443,92 @@ pub(crate) mod tests {
         }
     }
 
+    const DT: f32 = 1.0 / 240.0;
+
+    /// `ticks` ticks of the closed form one at a time.
+    fn tick_by_tick(start: PlanarState, desired: Vec2, k: &KindParams, ticks: u32) -> PlanarState {
+        let turn = TurnLimit::new(k, DT);
+        (0..ticks).fold(start, |s, _| planar_after(&s, desired, k, &turn, 1, DT))
+    }
+
     #[test]
     fn speed_rises_no_faster_than_the_acceleration_limit_and_stops_at_top_speed() {
         let k = kind();
-        let mut s = PlanarState::default();
-        let dt = 1.0 / 240.0;
-        for _ in 0..240 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
-        }
+        let after = |ticks: u32| {
+            let turn = TurnLimit::new(&k, ticks as f32 * DT);
+            planar_after(&PlanarState::default(), Vec2::new(10.0, 0.0), &k, &turn, ticks, DT)
+        };
+        let s = after(240);
         assert!(
             (s.velocity.x - 2.0).abs() < 1e-3,
             "after 1 s at 2 m/s^2: {}",
             s.velocity.x
         );
-        for _ in 0..480 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
-        }
-        assert!((s.velocity.length() - 3.0).abs() < 1e-4);
+        // Travelled: 1/2 a t^2, to within the half tick the ticks' sum adds.
+        assert!((s.position.x - 1.0).abs() < 5e-3, "{}", s.position.x);
+        let s = after(720);
+        assert_eq!(s.velocity, Vec2::new(3.0, 0.0));
         assert_eq!(s.heading, Vec2::X);
+        // 1.5 s to reach 3 m/s (2.25 m), then 1.5 s at it (4.5 m).
+        assert!((s.position.x - 6.75).abs() < 2e-2, "{}", s.position.x);
     }
 
     #[test]
     fn a_body_faster_than_its_top_speed_slows_at_the_acceleration_limit() {
         let k = kind();
-        let mut s = PlanarState {
+        let start = PlanarState {
             velocity: Vec2::new(4.0, 0.0),
             ..default()
         };
-        let dt = 1.0 / 240.0;
-        for _ in 0..120 {
-            step_planar(&mut s, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, dt), dt);
-        }
+        let s = planar_after(&start, Vec2::new(10.0, 0.0), &k, &TurnLimit::new(&k, 0.25), 60, DT);
         assert!(
-            (s.velocity.x - 3.0).abs() < 1e-3,
-            "after 0.5 s at 2 m/s^2: {}",
+            (s.velocity.x - 3.5).abs() < 1e-3,
+            "after 0.25 s at 2 m/s^2: {}",
             s.velocity.x
+        );
+        assert_eq!(
+            tick_by_tick(start, Vec2::new(10.0, 0.0), &k, 120).velocity,
+            Vec2::new(3.0, 0.0)
         );
     }
 
     #[test]
-    fn the_body_turns_to_face_its_direction_of_travel() {
+    fn a_stretch_worked_out_at_once_ends_where_its_ticks_one_by_one_do() {
         let k = kind();
-        let mut s = PlanarState {
+        let start = PlanarState {
+            position: Vec2::new(-3.0, 7.0),
+            velocity: Vec2::new(1.0, -0.5),
+            heading: Vec2::new(1.0, -0.5).normalize(),
+        };
+        // Reaching the target within the stretch, not reaching it, and already there.
+        for desired in [Vec2::new(1.02, -0.45), Vec2::new(-2.0, 1.0), Vec2::new(1.0, -0.5)] {
+            for ticks in [1, 3, 8] {
+                let whole = planar_after(&start, desired, &k, &TurnLimit::new(&k, ticks as f32 * DT), ticks, DT);
+                let steps = tick_by_tick(start, desired, &k, ticks);
+                assert!(
+                    whole.position.distance(steps.position) < 1e-5,
+                    "{desired} {ticks}: {whole:?} {steps:?}"
+                );
+                assert!(
+                    whole.velocity.distance(steps.velocity) < 1e-5,
+                    "{desired} {ticks}: {whole:?} {steps:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn the_body_turns_toward_its_travel_no_faster_than_its_turn_rate() {
+        let mut k = kind();
+        let start = PlanarState {
             velocity: Vec2::new(0.0, 1.0),
             ..default()
         };
-        step_planar(&mut s, Vec2::new(0.0, 1.0), &k, &TurnLimit::new(&k, 0.01), 0.01);
+        let s = planar_after(&start, Vec2::new(0.0, 1.0), &k, &TurnLimit::new(&k, 0.01), 1, 0.01);
         assert!((s.heading_angle() - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        k.turn_rate_rad_per_s = 1.0;
+        let s = planar_after(&start, Vec2::new(0.0, 1.0), &k, &TurnLimit::new(&k, 0.5), 50, 0.01);
+        assert!((s.heading_angle() - 0.5).abs() < 1e-6, "{}", s.heading_angle());
     }
 
     #[test]
@@ -343,8 +538,7 @@ pub(crate) mod tests {
         let mut flight_ticks = 0;
         let mut touchdowns = Vec::new();
         for i in 0..1100 {
-            let (period, stance, steps) = rhythm(&k, None, Vec2::ZERO);
-            g.advance(period, stance, steps, i as f32 * 0.001, 0.001);
+            g = Rhythm::of_kind(&k).advance(&g, 0.001, (i + 1) as f32 * 0.001);
             flight_ticks += g.in_flight as u32;
             if touchdowns.last() != Some(&g.last_touchdown_s) {
                 touchdowns.push(g.last_touchdown_s);
@@ -358,6 +552,12 @@ pub(crate) mod tests {
         assert!(
             (touchdowns[1] - 0.5).abs() < 2e-3 && (touchdowns[2] - 1.0).abs() < 2e-3,
             "{touchdowns:?}"
+        );
+        // The same second and a tenth at once: the same place in the cycle.
+        let once = Rhythm::of_kind(&k).advance(&GaitPhase::default(), 1.1, 1.1);
+        assert!(
+            (once.cycle - g.cycle).abs() < 1e-3 && (once.last_touchdown_s - 1.0).abs() < 1e-3,
+            "{once:?}"
         );
     }
 }

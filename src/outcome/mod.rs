@@ -23,12 +23,12 @@ use crate::contract::GaitPose;
 use crate::contract::{AtRigid, Lod};
 use crate::contract::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
 use crate::contract::{DesiredVelocity, GaitPhase, PlanarState, PlayerControlled};
-use crate::creature::{SerialCounter, creature_bundle, find_free_spot};
+use crate::creature::{Clearance, SerialCounter, creature_bundle, find_free_spot};
 use crate::kind::{Creature, KindParams, KindTable};
 use crate::lod::{
     BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SwitchProbe, SwitchTally,
 };
-use crate::models::point_mass::{FrameStep, FrameStepping, PlanarStepper};
+use crate::models::point_mass::{FrameStep, FrameStepping, PlanarSegment, PlanarStepper};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
 
@@ -170,7 +170,7 @@ const REACH_SLACK_M: f32 = 0.01;
 
 /// Whether a creature, at its state after this decision's contacts, could reach the puck or a
 /// wall within `frame_s`. A planar body's speed between decisions stays below the larger of its
-/// speed now and its top speed (`step_planar` moves it toward a target within the top speed).
+/// speed now and its top speed (`planar_after` moves it toward a target within the top speed).
 fn could_reach_puck_or_wall(
     state: &PlanarState,
     record: &CollisionRecord,
@@ -198,7 +198,7 @@ type FramePlan<'a> = (
     &'a DesiredVelocity,
     &'a mut GaitPhase,
     &'a mut GaitPose,
-    &'a mut FrameStep,
+    (&'a mut FrameStep, &'a mut PlanarSegment),
 );
 
 /// Puck, wall and (at each decision) creature contacts of the planar creatures. At each
@@ -222,7 +222,17 @@ fn detect_collisions(
     mut switched: MessageReader<LevelSwitched>,
     mut watch: Local<NearPuckOrWall>,
     mut chosen: Local<Parallel<Vec<Entity>>>,
-    mut creatures: Query<(Entity, &Creature, &mut PlanarState, &mut CollisionRecord, FramePlan), Without<AtRigid>>,
+    mut creatures: Query<
+        (
+            Entity,
+            &Creature,
+            &mut PlanarState,
+            &mut CollisionRecord,
+            &Clearance,
+            FramePlan,
+        ),
+        Without<AtRigid>,
+    >,
 ) {
     let collide = |entity, creature: &Creature, state: &mut PlanarState, record: &mut CollisionRecord, grid| {
         let kind = &kinds[creature.kind];
@@ -245,7 +255,7 @@ fn detect_collisions(
         }
         if !watch.check_all {
             for &entity in &watch.near {
-                if let Ok((entity, creature, mut state, mut record, _)) = creatures.get_mut(entity) {
+                if let Ok((entity, creature, mut state, mut record, _, _)) = creatures.get_mut(entity) {
                     collide(entity, creature, &mut state, &mut record, None);
                 }
             }
@@ -258,26 +268,35 @@ fn detect_collisions(
     let may_fall_behind = decision && stepping.is_none_or(|s| s.enabled) && clock.ticks_per_decision > 2;
     let stepper = PlanarStepper::new(&kinds, &clock);
     let in_frame = clock.tick_in_frame();
+    let widest_m = grid.fastest_and_widest().1;
     let chosen_now = &*chosen;
     let check = |entity: Entity,
                  creature: &Creature,
                  state: &mut PlanarState,
                  record: &mut CollisionRecord,
+                 clearance: &Clearance,
                  plan: FramePlanItem,
-                 frame: &mut FrameStep| {
+                 frame: &mut FrameStep,
+                 segment: &mut PlanarSegment| {
         let (lod, choice, probed, player, desired, gait, pose) = plan;
         if frame.behind {
             if !puck_outran {
                 return;
             }
-            stepper.step(creature, *lod, desired.0, state, gait, pose, in_frame);
+            stepper.catch_up(creature, *lod, desired.0, state, gait, pose, segment, in_frame);
             frame.behind = false;
         }
-        collide(entity, creature, state, record, decision.then_some(&*grid));
+        let kind = &kinds[creature.kind];
+        // Steering saw no creature near enough to touch now (but a player's creature does not steer).
+        let clear = !player
+            && clearance.clear_m > kind.radius_m + widest_m + state.velocity.length() * clock.dt + REACH_SLACK_M;
+        collide(entity, creature, state, record, (decision && !clear).then_some(&*grid));
+        if decision && clear {
+            record.note(Obstacle::Creature, false);
+        }
         if !decision {
             return;
         }
-        let kind = &kinds[creature.kind];
         let near = could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
         if near {
             chosen_now.borrow_local_mut().push(entity);
@@ -296,7 +315,8 @@ fn detect_collisions(
         creature,
         mut state,
         mut record,
-        (lod, choice, probed, player, desired, mut gait, mut pose, mut frame),
+        clearance,
+        (lod, choice, probed, player, desired, mut gait, mut pose, (mut frame, mut segment)),
     ) in creatures.contiguous_iter_mut().expect(DENSE)
     {
         let n = chunk_len(config.scenario.creature_count(), entity.len());
@@ -306,20 +326,25 @@ fn detect_collisions(
             pose.bypass_change_detection(),
             frame.bypass_change_detection(),
         );
-        let chunks = ((entity.chunks(n).zip(creature.chunks(n))).zip(state.chunks_mut(n).zip(record.chunks_mut(n))))
-            .zip(
-                (lod.chunks(n).zip(choice.chunks(n)).zip(desired.chunks(n)))
-                    .zip((gait.chunks_mut(n).zip(pose.chunks_mut(n))).zip(frame.chunks_mut(n))),
-            );
-        run_chunks(chunks.map(|(((e, c), (s, r)), (((l, ch), d), ((g, p), f)))| {
-            move || {
-                let rows = ((e.iter().zip(c)).zip(s.iter_mut().zip(r)))
-                    .zip((l.iter().zip(ch).zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut())));
-                for (((e, c), (s, r)), (((l, ch), d), ((g, p), f))) in rows {
-                    check(*e, c, s, r, (l, ch, probed, player, d, g, p), f);
+        let segment = segment.bypass_change_detection();
+        let chunks = ((entity.chunks(n).zip(creature.chunks(n)).zip(clearance.chunks(n)))
+            .zip(state.chunks_mut(n).zip(record.chunks_mut(n))))
+        .zip(
+            (lod.chunks(n).zip(choice.chunks(n)).zip(desired.chunks(n)))
+                .zip((gait.chunks_mut(n).zip(pose.chunks_mut(n))).zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)))),
+        );
+        run_chunks(
+            chunks.map(|((((e, c), cl), (s, r)), (((l, ch), d), ((g, p), (f, seg))))| {
+                move || {
+                    let rows = ((e.iter().zip(c).zip(cl)).zip(s.iter_mut().zip(r))).zip(
+                        (l.iter().zip(ch).zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut().zip(seg))),
+                    );
+                    for ((((e, c), cl), (s, r)), (((l, ch), d), ((g, p), (f, seg)))) in rows {
+                        check(*e, c, s, r, cl, (l, ch, probed, player, d, g, p), f, seg);
+                    }
                 }
-            }
-        }));
+            }),
+        );
     }
     if decision {
         switched.clear();
