@@ -30,6 +30,7 @@ use super::{LevelPolicy, Lod};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::contract::GaitPose;
 use crate::contract::SimClock;
+use crate::contract::{chunk_len, run_chunks};
 use crate::contract::{GaitPhase, PlanarState};
 use crate::contract::{SimStage, SimStart, StartStage};
 use crate::kind::{Creature, KindParams, KindTable, starting_gait};
@@ -427,9 +428,20 @@ fn decide(
     let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
     let mut rows: Vec<_> = creatures.iter().collect();
     rows.sort_unstable_by_key(|r| r.1.serial);
+    // Each creature's benefit is its own: worked out across the cores (most of the choice's time).
+    let mut benefits = vec![[0.0f32; 3]; rows.len()];
+    let n = chunk_len(config.scenario.creature_count(), rows.len());
+    run_chunks(rows.chunks(n).zip(benefits.chunks_mut(n)).map(|(rows, benefits)| {
+        move || {
+            for (&(entity, c, _, s, _), benefit) in rows.iter().zip(benefits) {
+                *benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
+            }
+        }
+    }));
     let candidates: Vec<Candidate> = rows
         .iter()
-        .map(|&(entity, c, &lod, s, choice)| {
+        .zip(benefits)
+        .map(|(&(_, c, &lod, _, choice), benefit)| {
             let kind = &kinds[c.kind];
             let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
             Candidate {
@@ -439,7 +451,7 @@ fn decide(
                 floor: if dwelling { lod } else { kind.levels[0] },
                 levels: &kind.levels,
                 costs: costs[c.kind],
-                benefit: scene.benefit(entity, c, s, kind),
+                benefit,
             }
         })
         .collect();

@@ -21,7 +21,15 @@ fn two_runs_with_one_seed_end_in_identical_states() {
 #[test]
 fn a_crowd_large_enough_to_run_in_parallel_is_deterministic_too() {
     let config = config_with_hoppers(simlod::PARALLEL_MIN_CREATURES * 2);
-    assert_eq!(digest_after(config.clone(), 3.0), digest_after(config, 3.0));
+    assert_eq!(digest_after(config.clone(), 3.0), digest_after(config.clone(), 3.0));
+    // The budget policy too, with room for more than point masses: its benefits are worked out
+    // across the cores.
+    let mut config = config;
+    config.scenario.level_policy = simlod::lod::LevelPolicy::Budget;
+    config.rules.budget.frame_budget_ms = 40.0;
+    let run = digest_after(config.clone(), 2.0);
+    assert_eq!(run, digest_after(config, 2.0));
+    assert!(run.1.levels_peak[Lod::Rigid] > 0, "{:?}", run.1);
 }
 
 #[test]
