@@ -282,8 +282,10 @@ impl<'a> PlanarStepper<'a> {
         }
     }
 
-    /// Moves a creature on its stretch to the end of this tick, beginning a new stretch from where
-    /// it is if it has left the one it was on (or `fresh`: the first tick after a decision).
+    /// Moves a creature on its stretch to the end of this tick. A new stretch begins from where
+    /// the creature is: as of the end of tick `since` where given (the first tick after a
+    /// decision; a creature behind its frame, held at its decision's tick), else as of the last
+    /// tick if anything but the stepper has moved it since.
     #[allow(clippy::too_many_arguments)]
     pub fn follow(
         &self,
@@ -294,39 +296,17 @@ impl<'a> PlanarStepper<'a> {
         gait: &mut GaitPhase,
         pose: &mut GaitPose,
         segment: &mut PlanarSegment,
-        fresh: bool,
+        since: Option<u64>,
     ) {
-        if fresh || !segment.holds(state, gait, desired, lod) {
-            *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - 1);
+        match since {
+            Some(tick) => *segment = PlanarSegment::begin(state, gait, desired, lod, tick),
+            None if !segment.holds(state, gait, desired, lod) => {
+                *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - 1);
+            }
+            None => {}
         }
         (*state, *gait) = (segment.start, segment.start_gait);
-        self.advance(
-            creature,
-            lod,
-            desired,
-            state,
-            gait,
-            pose,
-            self.clock.tick - segment.tick,
-        );
-        (segment.published, segment.published_gait) = (*state, *gait);
-    }
-
-    /// Catches up a creature behind its frame, `ticks` ticks after its decision's tick, as if it
-    /// had followed its stretch a tick at a time.
-    #[allow(clippy::too_many_arguments)]
-    pub fn catch_up(
-        &self,
-        creature: &Creature,
-        lod: Lod,
-        desired: Vec2,
-        state: &mut PlanarState,
-        gait: &mut GaitPhase,
-        pose: &mut GaitPose,
-        segment: &mut PlanarSegment,
-        ticks: u64,
-    ) {
-        *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - ticks);
+        let ticks = self.clock.tick - segment.tick;
         self.advance(creature, lod, desired, state, gait, pose, ticks);
         (segment.published, segment.published_gait) = (*state, *gait);
     }
@@ -365,7 +345,10 @@ fn step_point_masses(
                 stepper.advance(creature, lod, desired, state, gait, pose, in_frame);
             }
             (false, 0) => stepper.advance(creature, lod, desired, state, gait, pose, 1),
-            (false, _) => stepper.follow(creature, lod, desired, state, gait, pose, segment, in_frame == 1),
+            (false, _) => {
+                let since = (in_frame == 1).then(|| clock.tick - 1);
+                stepper.follow(creature, lod, desired, state, gait, pose, segment, since);
+            }
         }
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch

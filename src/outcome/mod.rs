@@ -283,7 +283,8 @@ fn detect_collisions(
             if !puck_outran {
                 return;
             }
-            stepper.catch_up(creature, *lod, desired.0, state, gait, pose, segment, in_frame);
+            let since = Some(clock.tick - in_frame);
+            stepper.follow(creature, *lod, desired.0, state, gait, pose, segment, since);
             frame.behind = false;
         }
         let kind = &kinds[creature.kind];
