@@ -219,6 +219,9 @@ impl PlanarSegment {
     }
 }
 
+/// What moving a planar creature writes: its body on the plane, its gait and its pose.
+pub type Moving<'a> = (&'a mut PlanarState, &'a mut GaitPhase, &'a mut GaitPose);
+
 /// Works out planar creatures' states: what each kind needs, once per system run.
 pub struct PlanarStepper<'a> {
     kinds: &'a KindTable,
@@ -249,16 +252,7 @@ impl<'a> PlanarStepper<'a> {
     /// Moves one creature from the state and gait it holds, `ticks` ticks before the end of
     /// this tick, to the end of this tick at its desired velocity: the plane, the gait's
     /// rhythm, and (for a hybrid) the pose, which depends on the speed and the gait's place alone.
-    pub fn advance(
-        &self,
-        creature: &Creature,
-        lod: Lod,
-        desired: Vec2,
-        state: &mut PlanarState,
-        gait: &mut GaitPhase,
-        pose: &mut GaitPose,
-        ticks: u64,
-    ) {
+    pub fn advance(&self, creature: &Creature, lod: Lod, desired: Vec2, (state, gait, pose): Moving, ticks: u64) {
         let kind = &self.kinds[creature.kind];
         let table = match (lod, &kind.gait) {
             (Lod::Hybrid, Some(table)) => Some(table),
@@ -286,15 +280,12 @@ impl<'a> PlanarStepper<'a> {
     /// the creature is: as of the end of tick `since` where given (the first tick after a
     /// decision; a creature behind its frame, held at its decision's tick), else as of the last
     /// tick if anything but the stepper has moved it since.
-    #[allow(clippy::too_many_arguments)]
     pub fn follow(
         &self,
         creature: &Creature,
         lod: Lod,
         desired: Vec2,
-        state: &mut PlanarState,
-        gait: &mut GaitPhase,
-        pose: &mut GaitPose,
+        (state, gait, pose): Moving,
         segment: &mut PlanarSegment,
         since: Option<u64>,
     ) {
@@ -307,7 +298,7 @@ impl<'a> PlanarStepper<'a> {
         }
         (*state, *gait) = (segment.start, segment.start_gait);
         let ticks = self.clock.tick - segment.tick;
-        self.advance(creature, lod, desired, state, gait, pose, ticks);
+        self.advance(creature, lod, desired, (state, gait, pose), ticks);
         (segment.published, segment.published_gait) = (*state, *gait);
     }
 }
@@ -335,19 +326,19 @@ fn step_point_masses(
     let step = |creature: &Creature,
                 lod: Lod,
                 desired: Vec2,
-                (state, gait, pose): (&mut PlanarState, &mut GaitPhase, &mut GaitPose),
+                moving: Moving<'_>,
                 frame: &mut FrameStep,
                 segment: &mut PlanarSegment| {
         match (frame.behind, in_frame) {
             (true, _) if !last_of_frame => {}
             (true, _) => {
                 frame.behind = false;
-                stepper.advance(creature, lod, desired, state, gait, pose, in_frame);
+                stepper.advance(creature, lod, desired, moving, in_frame);
             }
-            (false, 0) => stepper.advance(creature, lod, desired, state, gait, pose, 1),
+            (false, 0) => stepper.advance(creature, lod, desired, moving, 1),
             (false, _) => {
                 let since = (in_frame == 1).then(|| clock.tick - 1);
-                stepper.follow(creature, lod, desired, state, gait, pose, segment, since);
+                stepper.follow(creature, lod, desired, moving, segment, since);
             }
         }
     };

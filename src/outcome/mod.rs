@@ -284,7 +284,7 @@ fn detect_collisions(
                 return;
             }
             let since = Some(clock.tick - in_frame);
-            stepper.follow(creature, *lod, desired.0, state, gait, pose, segment, since);
+            stepper.follow(creature, *lod, desired.0, (state, gait, pose), segment, since);
             frame.behind = false;
         }
         let kind = &kinds[creature.kind];
