@@ -169,6 +169,23 @@ pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32, least
     }
 }
 
+/// Whether any creature's cheapest step up from its floor fits in `budget_us` beside every
+/// creature at its floor: if not, [`allocate`] gives every creature its floor.
+fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
+    let floors_us: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
+    let cheapest_step_us = candidates
+        .iter()
+        .flat_map(|c| {
+            let floor_us = c.cost_us(c.floor);
+            c.levels
+                .iter()
+                .filter(move |&&l| l > c.floor)
+                .map(move |&l| c.cost_us(l) - floor_us)
+        })
+        .fold(f32::INFINITY, f32::min);
+    floors_us + cheapest_step_us <= budget_us
+}
+
 /// The adaptive mode's correction of the cost model after one more measured frame: the
 /// measured over the predicted time, smoothed over about `frames` frames. A ratio beyond 10
 /// either way (a stalled frame) counts as 10.
@@ -428,20 +445,9 @@ fn decide(
     let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
     let mut rows: Vec<_> = creatures.iter().collect();
     rows.sort_unstable_by_key(|r| r.1.serial);
-    // Each creature's benefit is its own: worked out across the cores (most of the choice's time).
-    let mut benefits = vec![[0.0f32; 3]; rows.len()];
-    let n = chunk_len(config.scenario.creature_count(), rows.len());
-    run_chunks(rows.chunks(n).zip(benefits.chunks_mut(n)).map(|(rows, benefits)| {
-        move || {
-            for (&(entity, c, _, s, _), benefit) in rows.iter().zip(benefits) {
-                *benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
-            }
-        }
-    }));
-    let candidates: Vec<Candidate> = rows
+    let mut candidates: Vec<Candidate> = rows
         .iter()
-        .zip(benefits)
-        .map(|(&(_, c, &lod, _, choice), benefit)| {
+        .map(|&(_, c, &lod, _, choice)| {
             let kind = &kinds[c.kind];
             let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
             Candidate {
@@ -451,20 +457,29 @@ fn decide(
                 floor: if dwelling { lod } else { kind.levels[0] },
                 levels: &kind.levels,
                 costs: costs[c.kind],
-                benefit,
+                benefit: [0.0; 3],
             }
         })
         .collect();
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
-    let overhead_us = config.costs.overhead_us(candidates.len());
     let rules = &config.rules.budget;
-    let mut allocation = allocate(
-        &candidates,
-        budget_us - overhead_us,
-        rules.hysteresis,
-        rules.least_benefit_per_ms / 1e3,
-    );
-    allocation.predicted_us += overhead_us;
+    let room_us = budget_us - config.costs.overhead_us(candidates.len());
+    // Where not one step up fits, every creature keeps its floor whatever the benefits: they
+    // are not worked out, and the choice costs next to nothing (a crowd far over its budget).
+    let choosing = any_step_fits(&candidates, room_us);
+    if choosing {
+        // Each creature's benefit is its own: worked out across the cores (most of the choice's time).
+        let n = chunk_len(config.scenario.creature_count(), rows.len());
+        run_chunks(rows.chunks(n).zip(candidates.chunks_mut(n)).map(|(rows, candidates)| {
+            move || {
+                for (&(entity, c, _, s, _), candidate) in rows.iter().zip(candidates) {
+                    candidate.benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
+                }
+            }
+        }));
+    }
+    let mut allocation = allocate(&candidates, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
+    allocation.predicted_us += config.costs.overhead_us(if choosing { candidates.len() } else { 0 });
     (rows.iter().map(|r| r.0).collect(), allocation)
 }
 
@@ -609,6 +624,27 @@ mod tests {
             costs: COSTS,
             benefit: [0.0, 0.5, rigid_benefit],
         }
+    }
+
+    #[test]
+    fn where_no_step_up_fits_beside_the_floors_every_creature_keeps_its_floor() {
+        // Three at the point mass (1 us each); the cheapest step is to the hybrid (1 us more).
+        let crowd: Vec<Candidate> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
+        let floors = vec![Lod::PointMass; 3];
+        for budget_us in [0.0, 2.0, 3.9] {
+            assert!(!any_step_fits(&crowd, budget_us));
+            assert_eq!(allocate(&crowd, budget_us, 0.0, 0.0).levels, floors, "{budget_us} us");
+        }
+        assert!(any_step_fits(&crowd, 4.0));
+        assert_ne!(allocate(&crowd, 4.0, 0.0, 0.0).levels, floors);
+        // A rigid creature dwelling at its level: its floor is rigid, its own cost counts.
+        let dwelling = Candidate {
+            floor: Lod::Rigid,
+            ..candidate(3, Lod::Rigid, 9.0)
+        };
+        let crowd = [crowd, vec![dwelling]].concat();
+        assert!(!any_step_fits(&crowd, 103.9));
+        assert!(any_step_fits(&crowd, 104.0));
     }
 
     #[test]

@@ -16,8 +16,8 @@ use super::select::{LevelChoice, SimCamera, levels_may_change};
 use super::{LevelPolicy, Lod};
 use crate::contract::GaitPose;
 use crate::contract::{CollisionRecord, Counts, SwitchCounts};
+use crate::contract::{DENSE, SimClock, SimStage, SimStart};
 use crate::contract::{GaitPhase, PlanarState};
-use crate::contract::{SimClock, SimStage, SimStart};
 use crate::kind::{Creature, KindTable};
 
 /// A creature changed level.
@@ -66,6 +66,7 @@ fn switch_levels(
     camera: Res<SimCamera>,
     mut tally: ResMut<SwitchTally>,
     mut switched: MessageWriter<LevelSwitched>,
+    mut kept: Local<(Vec<Entity>, Vec<Entity>)>,
     mut creatures: Query<(
         Entity,
         &Creature,
@@ -80,7 +81,30 @@ fn switch_levels(
     let (open, close) = config.rules.flight_window;
     let policy = config.scenario.level_policy;
     let rules_move_levels = policy.is_dynamic();
-    for (entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before)) in &mut creatures {
+    // Most ticks nothing switches: one pass over the columns finds the creatures that want
+    // another level or might be forced to rigid (in the query's order, so the switches come in
+    // the same order as a pass over every creature). Of those that waited for their window
+    // last tick, the others let go of the drawing they kept.
+    let (attend, waiting) = &mut *kept;
+    attend.clear();
+    for (entity, _, lod, choice, _, record, _) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
+        let rows = entity.iter().zip(lod).zip(choice).zip(record);
+        attend.extend(rows.filter_map(|(((&e, &lod), choice), record)| {
+            let may_be_forced = rules_move_levels && lod != Lod::Rigid && record.touching.iter().any(|&t| t);
+            (choice.wanted != lod || may_be_forced).then_some(e)
+        }));
+    }
+    for entity in waiting.drain(..).filter(|e| !attend.contains(e)) {
+        if let Ok((.., (_, _, _, mut before))) = creatures.get_mut(entity) {
+            before.0 = None;
+        }
+    }
+    for &entity in attend.iter() {
+        let Ok((entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before))) =
+            creatures.get_mut(entity)
+        else {
+            continue;
+        };
         let kind = &kinds[creature.kind];
         // Under a fixed policy ("every creature at the point-mass level") a collision does not
         // overrule it; under the budget policy only a rigid level the budget paid for skips
@@ -105,6 +129,7 @@ fn switch_levels(
         let skips_window = forced || unseen;
         if !skips_window && !progress.is_some_and(|p| (open..=close).contains(&p)) {
             before.0 = Some(seen);
+            waiting.push(entity);
             continue;
         }
         // A creature that switches without waiting (a collision) has no drawing kept from

@@ -568,3 +568,47 @@ fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
         assert_eq!(number(6), number(1), "all {} at the point-mass level", r[1]);
     }
 }
+
+#[test]
+fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys_more_with_more() {
+    let dir = scratch_dir("budget_scale");
+    let file = dir.join("budget_scale.ron");
+    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], seconds: 0.3, seed: 3)";
+    std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
+    let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
+    every_file_it_says_it_wrote_exists(&said, &dir);
+    let rows = table(&dir.join("budget-scale.csv"));
+    let games: Vec<(&str, &str, &str)> = rows[1..]
+        .iter()
+        .map(|r| (r[0].as_str(), r[1].as_str(), r[2].as_str()))
+        .collect();
+    let mut want = Vec::new();
+    for n in ["30", "90"] {
+        for b in ["0.4", "3"] {
+            for a in ["0", "20"] {
+                want.push((n, b, a));
+            }
+        }
+    }
+    assert_eq!(games, want);
+    // The cost model alone is reproducible: a larger budget buys more rigid creatures.
+    let rigid = |n: &str, b: &str| {
+        let r = rows.iter().find(|r| r[0] == n && r[1] == b && r[2] == "0").unwrap();
+        r[10].parse::<f64>().unwrap()
+    };
+    assert!(rigid("90", "3") > rigid("90", "0.4"), "{rows:?}");
+    assert_eq!(
+        said.matches("\n| 30 |").count() + said.matches("\n| 90 |").count(),
+        8,
+        "{said}"
+    );
+    assert!(said.contains("of 8 games"), "{said}");
+    // Sizes out of order are refused with the field named.
+    std::fs::write(
+        &file,
+        format!("(full: {0}, quick: {0})", settings.replace("[30, 90]", "[90, 30]")),
+    )
+    .unwrap();
+    let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
+    assert!(err.to_string().contains("creatures"), "{err}");
+}

@@ -33,6 +33,9 @@ pub(crate) enum ExperimentKind {
     /// Beyond the paper: figure 7 taken to crowds, every policy's frame time from a hundred
     /// creatures to a million.
     Crowd(ExperimentRun),
+    /// Beyond the paper: the budget policy at every crowd size, its measured frame against its
+    /// budget, with the cost model alone and corrected by measured frames.
+    BudgetScale(ExperimentRun),
     /// Every experiment, into one folder.
     All(ExperimentRun),
     /// Combine fig10 shards (`--shard K/N` runs) into the files of one unsharded run.

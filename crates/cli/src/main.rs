@@ -73,6 +73,7 @@ fn main() -> ExitCode {
             ExperimentKind::Fig10(run) => run.run("fig10"),
             ExperimentKind::Budget(run) => run.run("budget"),
             ExperimentKind::Crowd(run) => run.run("crowd"),
+            ExperimentKind::BudgetScale(run) => run.run("budget-scale"),
             ExperimentKind::All(run) => run.run("all"),
             ExperimentKind::Merge { dirs, out } => {
                 (experiments::fig10::merge(&dirs, &out).map(|summary| print!("{summary}"))).map_err(Failure::from)

@@ -7,6 +7,7 @@
 //! simulation on one thread; they can be split into shards and merged.
 
 pub mod budget;
+pub mod budget_scale;
 pub mod crowd;
 pub mod fig10;
 pub mod fig7;
@@ -132,7 +133,7 @@ pub fn check_kind(config: &SimConfig, file: &Path, field: &str, kind: &str, leve
 /// would run at the level below it and be reported under the wrong level's name.
 fn compared_levels(name: &str) -> &'static [Lod] {
     match name {
-        "fig8" | "fig10" | "budget" => &[Lod::Hybrid, Lod::Rigid],
+        "fig8" | "fig10" | "budget" | "budget-scale" => &[Lod::Hybrid, Lod::Rigid],
         "fig9" | "crowd" => &Lod::ALL,
         // table1 measures each kind at the levels it has; fig7 and step-response run one kind
         // from their own file and check it there.
@@ -289,6 +290,14 @@ pub fn mean_and_variance(values: &[f64]) -> (f64, f64) {
     (mean, variance)
 }
 
+/// The 99th percentile of frame times given in seconds, in ms.
+pub fn p99_ms(frames_s: &[f64]) -> f64 {
+    let mut sorted = frames_s.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let at = (sorted.len() as f64 * 0.99).ceil() as usize;
+    sorted.get(at.saturating_sub(1)).map_or(0.0, |s| s * 1e3)
+}
+
 /// The median of some values (NaN if there are none).
 pub fn median_of(values: impl IntoIterator<Item = f64>) -> f64 {
     let v: Vec<f64> = values.into_iter().collect();
@@ -321,7 +330,7 @@ pub fn command(name: &str, options: &Options) -> String {
 }
 
 /// The experiments `simlod experiment all` runs, in the report's order.
-pub const ALL: [&str; 8] = report::ORDER;
+pub const ALL: [&str; 9] = report::ORDER;
 
 /// The experiment file `name` reads unless told otherwise: under the assets folder.
 pub fn default_file(assets: &Path, name: &str) -> PathBuf {
@@ -352,6 +361,7 @@ pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options)
         "fig10" => fig10::run(config, file, options),
         "budget" => budget::run(config, file, options),
         "crowd" => crowd::run(config, file, options),
+        "budget-scale" => budget_scale::run(config, file, options),
         _ => Err(LabError::Invalid(format!(
             "no experiment {name:?}; there are {}",
             ALL.join(", ")

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use super::{ExperimentRecord, write_out};
 
 /// The experiments in the order the report shows them.
-pub const ORDER: [&str; 8] = [
+pub const ORDER: [&str; 9] = [
     "step-response",
     "table1",
     "fig7",
@@ -17,6 +17,7 @@ pub const ORDER: [&str; 8] = [
     "fig10",
     "budget",
     "crowd",
+    "budget-scale",
 ];
 
 /// Rewrites `report.md` in `out` from the experiments whose JSON is there.

@@ -27,7 +27,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
-use super::{ExperimentRecord, Options, command, load_settings, run_parallel, timed_game, trials};
+use super::{ExperimentRecord, Options, command, load_settings, p99_ms, run_parallel, timed_game, trials};
 use simlod::config::{LevelRules, SimConfig, Validate, Validator, load_costs, load_file};
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::outcome::{Counts, Obstacle};
@@ -233,14 +233,6 @@ fn run_trial(config: &SimConfig, rules: &Rules, s: &BudgetSettings, settings: &[
             }
         })
         .collect()
-}
-
-/// The 99th percentile of frame times given in seconds, in ms.
-fn p99_ms(frames_s: &[f64]) -> f64 {
-    let mut sorted = frames_s.to_vec();
-    sorted.sort_by(f64::total_cmp);
-    let at = (sorted.len() as f64 * 0.99).ceil() as usize;
-    sorted.get(at.saturating_sub(1)).map_or(0.0, |s| s * 1e3)
 }
 
 /// Figures per setting.

@@ -1,0 +1,254 @@
+//! The budget at every crowd size: the budget policy under the scenario's own rules and cost
+//! model (the game's), for each crowd size and each frame budget, with the cost model alone
+//! and corrected by the measured frames (the adaptive mode). Each game's frames are timed: the
+//! mean and the 99th percentile against the budget, and what the policy predicted.
+
+use crate::error::LabError;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::plot::{self, Mark, Panel, Series};
+use super::{ExperimentRecord, Options, command, load_settings, p99_ms, timed_game};
+use crate::bench::scaled;
+use simlod::config::{SimConfig, Validate, Validator};
+use simlod::lod::{LevelPolicy, Lod};
+
+/// `assets/experiments/budget_scale.ron`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetScaleSettings {
+    /// The crowd sizes, smallest first (the scenario's mix, its court grown to its density).
+    pub creatures: Vec<u32>,
+    /// The frame budgets, ms of simulation per 1/30 s.
+    pub budgets_ms: Vec<f32>,
+    /// The adaptive mode's settings: 0 is the cost model alone; above, the frames over which
+    /// the correction by measured frames is smoothed.
+    pub adaptive_frames: Vec<f32>,
+    /// Simulated seconds of each game.
+    pub seconds: f32,
+    /// The games' seed.
+    pub seed: u64,
+}
+
+impl Validate for BudgetScaleSettings {
+    fn validate(&self, v: &mut Validator) {
+        v.require(
+            !self.creatures.is_empty() && self.creatures.windows(2).all(|w| w[0] < w[1]),
+            "creatures",
+            "must list crowd sizes, smallest first",
+        );
+        for (i, &n) in self.creatures.iter().enumerate() {
+            v.require(
+                (1..=simlod::config::MAX_CREATURES).contains(&n),
+                &format!("creatures[{i}]"),
+                format!(
+                    "must be between 1 and {} creatures, got {n}",
+                    simlod::config::MAX_CREATURES
+                ),
+            );
+        }
+        v.require(
+            !self.budgets_ms.is_empty(),
+            "budgets_ms",
+            "must list at least one budget",
+        );
+        for (i, &b) in self.budgets_ms.iter().enumerate() {
+            v.range(&format!("budgets_ms[{i}]"), b, 0.01, 10_000.0);
+        }
+        v.require(
+            !self.adaptive_frames.is_empty(),
+            "adaptive_frames",
+            "must list at least one setting",
+        );
+        for (i, &a) in self.adaptive_frames.iter().enumerate() {
+            v.within(&format!("adaptive_frames[{i}]"), a, 0.0, 10_000.0);
+        }
+        v.range("seconds", self.seconds, 1.0 / 30.0, 600.0);
+    }
+}
+
+/// One game: a crowd size, a budget, a setting of the adaptive mode.
+#[derive(Clone, Debug, Serialize)]
+struct Game {
+    creatures: u32,
+    budget_ms: f32,
+    adaptive_frames: f32,
+    frames: usize,
+    mean_frame_ms: f64,
+    p99_frame_ms: f64,
+    predicted_mean_ms: f64,
+    /// Decisions where even the cheapest levels allowed were predicted over the budget.
+    decisions_over_budget: u64,
+    decisions: u64,
+    rigid: f64,
+    hybrid: f64,
+}
+
+impl Game {
+    fn mean_over_budget(&self) -> f64 {
+        self.mean_frame_ms / f64::from(self.budget_ms)
+    }
+}
+
+fn game(config: &SimConfig, s: &BudgetScaleSettings, creatures: u32, budget_ms: f32, adaptive_frames: f32) -> Game {
+    let mut c = scaled(config, creatures, LevelPolicy::Budget);
+    c.scenario.seed = s.seed;
+    c.rules.budget.frame_budget_ms = budget_ms;
+    c.rules.budget.adaptive_frames = adaptive_frames;
+    let (frames, summary) = timed_game(c, f64::from(s.seconds));
+    let budget = summary
+        .budget
+        .expect("a game under the budget policy reports its budget");
+    Game {
+        creatures,
+        budget_ms,
+        adaptive_frames,
+        frames: frames.len(),
+        mean_frame_ms: frames.iter().sum::<f64>() * 1e3 / frames.len().max(1) as f64,
+        p99_frame_ms: p99_ms(&frames),
+        predicted_mean_ms: budget.predicted_ms_mean,
+        decisions_over_budget: budget.decisions_over_budget,
+        decisions: budget.decisions,
+        rigid: summary.levels_mean[Lod::Rigid],
+        hybrid: summary.levels_mean[Lod::Hybrid],
+    }
+}
+
+const HEADER: &str = "creatures,budget_ms,adaptive_frames,frames,mean_frame_ms,p99_frame_ms,predicted_mean_ms,decisions_over_budget,decisions,hybrid,rigid";
+
+/// Runs the experiment from `file`: every game, one at a time; writes its CSV, plot, JSON and
+/// report and returns what it says.
+pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
+    let s: BudgetScaleSettings = load_settings(file, options)?;
+    let total = s.creatures.len() * s.budgets_ms.len() * s.adaptive_frames.len();
+    let mut progress = super::Progress::new("budget at every crowd size", total as u64);
+    let mut games = Vec::with_capacity(total);
+    for &n in &s.creatures {
+        for &b in &s.budgets_ms {
+            for &a in &s.adaptive_frames {
+                games.push(game(config, &s, n, b, a));
+                progress.inc();
+            }
+        }
+    }
+    drop(progress);
+    let mut csv = format!("{HEADER}\n");
+    for g in &games {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{},{:.4},{:.4},{:.4},{},{},{:.1},{:.1}",
+            g.creatures,
+            g.budget_ms,
+            g.adaptive_frames,
+            g.frames,
+            g.mean_frame_ms,
+            g.p99_frame_ms,
+            g.predicted_mean_ms,
+            g.decisions_over_budget,
+            g.decisions,
+            g.hybrid,
+            g.rigid
+        );
+    }
+    draw(&games, &s, options)?;
+    ExperimentRecord {
+        experiment: "budget-scale".into(),
+        command: command("budget-scale", options),
+        summary: serde_json::json!({ "games": games }),
+        report: report(&games, &s),
+        smoke_test: options.quick,
+    }
+    .finish(&options.out, &csv)
+}
+
+/// The measured mean frame over the budget against the crowd size: one line per budget and
+/// setting of the adaptive mode, the budget itself at 1.
+fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<(), LabError> {
+    let mut series = Vec::new();
+    for (i, &b) in s.budgets_ms.iter().enumerate() {
+        for &a in &s.adaptive_frames {
+            let points = games
+                .iter()
+                .filter(|g| g.budget_ms == b && g.adaptive_frames == a)
+                .map(|g| (f64::from(g.creatures).log10(), g.mean_over_budget()))
+                .collect();
+            let (label, mark) = if a > 0.0 {
+                (format!("{b} ms, adaptive ({a} frames)"), Mark::Dashed)
+            } else {
+                (format!("{b} ms, the cost model alone"), Mark::Line)
+            };
+            series.push(Series::new(label, points, mark, i));
+        }
+    }
+    let (lo, hi) = (
+        f64::from(s.creatures[0]).log10(),
+        f64::from(*s.creatures.last().expect("validated: not empty")).log10(),
+    );
+    for (label, y) in [("the budget", 1.0), ("10 % over", 1.1)] {
+        series.push(Series::new(
+            label,
+            vec![(lo, y), (hi, y)],
+            Mark::Dashed,
+            plot::REFERENCE,
+        ));
+    }
+    plot::draw(
+        &options.out.join("budget-scale.png"),
+        1000,
+        650,
+        &[Panel {
+            title: format!(
+                "the budget policy's mean frame against its budget: games of {} s",
+                s.seconds
+            ),
+            x_label: "creatures, log10 (2 is 100, 5 is 100,000)".into(),
+            y_label: "mean frame over the budget (log)".into(),
+            log_y: true,
+            series,
+            ..Panel::default()
+        }],
+        options.quick,
+    )?;
+    Ok(())
+}
+
+fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
+    let mut report = format!(
+        "The budget policy under the scenario's own rules and cost model (the game's), seed {}, games of {} s: the scenario's mix, \
+         the court grown with the count to the default game's density. Every frame's simulation timed on this machine's cores. \
+         The budget is kept where the mean frame is within 10 % of it and the 99th percentile within 25 %. \
+         Over budget: the decisions where even the cheapest levels were predicted over it.\n\n\
+         | creatures | budget (ms) | adaptive | mean frame (ms) | 99th percentile (ms) | predicted (ms) | kept | over budget | hybrid | rigid |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
+        s.seed, s.seconds
+    );
+    for g in games {
+        let kept = g.mean_frame_ms <= 1.1 * f64::from(g.budget_ms) && g.p99_frame_ms <= 1.25 * f64::from(g.budget_ms);
+        let _ = writeln!(
+            report,
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {} of {} | {:.0} | {:.0} |",
+            g.creatures,
+            g.budget_ms,
+            if g.adaptive_frames > 0.0 {
+                format!("{} frames", g.adaptive_frames)
+            } else {
+                "off".into()
+            },
+            g.mean_frame_ms,
+            g.p99_frame_ms,
+            g.predicted_mean_ms,
+            if kept { "yes" } else { "no" },
+            g.decisions_over_budget,
+            g.decisions,
+            g.hybrid,
+            g.rigid
+        );
+    }
+    let kept = games
+        .iter()
+        .filter(|g| g.mean_frame_ms <= 1.1 * f64::from(g.budget_ms) && g.p99_frame_ms <= 1.25 * f64::from(g.budget_ms))
+        .count();
+    let _ = write!(report, "\nKept in {kept} of {} games.\n", games.len());
+    report
+}
