@@ -433,7 +433,7 @@ type Creatures<'w, 's> = Query<
     ),
 >;
 
-/// The allocation for every creature now, in the order of their serials.
+/// The allocation for every creature now, in the query's order.
 fn decide(
     now_s: f32,
     config: &SimConfig,
@@ -443,9 +443,8 @@ fn decide(
     budget_us: f32,
 ) -> (Vec<Entity>, Allocation) {
     let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
-    let mut rows: Vec<_> = creatures.iter().collect();
-    rows.sort_unstable_by_key(|r| r.1.serial);
-    let mut candidates: Vec<Candidate> = rows
+    let rows: Vec<_> = creatures.iter().collect();
+    let candidates: Vec<Candidate> = rows
         .iter()
         .map(|&(_, c, &lod, _, choice)| {
             let kind = &kinds[c.kind];
@@ -464,23 +463,38 @@ fn decide(
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let rules = &config.rules.budget;
     let room_us = budget_us - config.costs.overhead_us(candidates.len());
+    let entities = rows.iter().map(|r| r.0).collect();
     // Where not one step up fits, every creature keeps its floor whatever the benefits: they
     // are not worked out, and the choice costs next to nothing (a crowd far over its budget).
-    let choosing = any_step_fits(&candidates, room_us);
-    if choosing {
-        // Each creature's benefit is its own: worked out across the cores (most of the choice's time).
-        let n = chunk_len(config.scenario.creature_count(), rows.len());
-        run_chunks(rows.chunks(n).zip(candidates.chunks_mut(n)).map(|(rows, candidates)| {
-            move || {
-                for (&(entity, c, _, s, _), candidate) in rows.iter().zip(candidates) {
-                    candidate.benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
-                }
-            }
-        }));
+    if !any_step_fits(&candidates, room_us) {
+        let mut allocation = allocate(&candidates, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
+        allocation.predicted_us += config.costs.overhead_us(0);
+        return (entities, allocation);
     }
-    let mut allocation = allocate(&candidates, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
-    allocation.predicted_us += config.costs.overhead_us(if choosing { candidates.len() } else { 0 });
-    (rows.iter().map(|r| r.0).collect(), allocation)
+    // In the order of the serials (ties go to the lower); each creature's benefit is its own,
+    // worked out across the cores (most of the choice's time).
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_unstable_by_key(|&i| rows[i].1.serial);
+    let mut by_serial: Vec<Candidate> = order.iter().map(|&i| candidates[i].clone()).collect();
+    let n = chunk_len(config.scenario.creature_count(), rows.len());
+    run_chunks(order.chunks(n).zip(by_serial.chunks_mut(n)).map(|(order, candidates)| {
+        let rows = &rows;
+        move || {
+            for (&i, candidate) in order.iter().zip(candidates) {
+                let (entity, c, _, s, _) = rows[i];
+                candidate.benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
+            }
+        }
+    }));
+    let mut allocation = allocate(&by_serial, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
+    allocation.predicted_us += config.costs.overhead_us(candidates.len());
+    // Back in the query's order.
+    let mut levels = vec![Lod::PointMass; rows.len()];
+    for (&i, &level) in order.iter().zip(&allocation.levels) {
+        levels[i] = level;
+    }
+    allocation.levels = levels;
+    (entities, allocation)
 }
 
 fn scene<'a>(
@@ -509,8 +523,8 @@ fn scene<'a>(
 }
 
 impl DecisionInputs<'_, '_> {
-    /// The allocation for every creature now, in the order of their serials: within the
-    /// budget as the cost model predicts it, times `correction`.
+    /// The allocation for every creature now, in the query's order: within the budget as the
+    /// cost model predicts it, times `correction`.
     fn decide(&self, creatures: &Creatures, correction: f32) -> (Vec<Entity>, Allocation) {
         let budget_us = self.config.rules.budget.frame_budget_ms * 1e3 / correction;
         let scene = scene(
@@ -544,12 +558,11 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     {
         tally.correction = corrected(tally.correction, tally.model_us, measured_us, frames);
     }
-    let (entities, allocation) = inputs.decide(&creatures, tally.correction);
+    let (_, allocation) = inputs.decide(&creatures, tally.correction);
     tally.record(&allocation);
-    for (entity, &level) in entities.iter().zip(&allocation.levels) {
-        if let Ok((.., mut choice)) = creatures.get_mut(*entity)
-            && choice.wanted != level
-        {
+    // In the query's order, as decided.
+    for ((.., mut choice), &level) in creatures.iter_mut().zip(&allocation.levels) {
+        if choice.wanted != level {
             choice.wanted = level;
         }
     }
