@@ -33,21 +33,7 @@ pub struct BudgetScaleSettings {
 
 impl Validate for BudgetScaleSettings {
     fn validate(&self, v: &mut Validator) {
-        v.require(
-            !self.creatures.is_empty() && self.creatures.windows(2).all(|w| w[0] < w[1]),
-            "creatures",
-            "must list crowd sizes, smallest first",
-        );
-        for (i, &n) in self.creatures.iter().enumerate() {
-            v.require(
-                (1..=simlod::config::MAX_CREATURES).contains(&n),
-                &format!("creatures[{i}]"),
-                format!(
-                    "must be between 1 and {} creatures, got {n}",
-                    simlod::config::MAX_CREATURES
-                ),
-            );
-        }
+        super::validate_crowd_sizes(v, &self.creatures);
         v.require(
             !self.budgets_ms.is_empty(),
             "budgets_ms",
@@ -181,10 +167,7 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
             series.push(Series::new(label, points, mark, i));
         }
     }
-    let (lo, hi) = (
-        f64::from(s.creatures[0]).log10(),
-        f64::from(*s.creatures.last().expect("validated: not empty")).log10(),
-    );
+    let (lo, hi) = super::log10_span(&s.creatures);
     for (label, y) in [("the budget", 1.0), ("10 % over", 1.1)] {
         series.push(Series::new(
             label,

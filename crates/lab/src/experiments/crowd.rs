@@ -35,21 +35,7 @@ pub struct CrowdSettings {
 impl Validate for CrowdSettings {
     fn validate(&self, v: &mut Validator) {
         v.require(!self.policies.is_empty(), "policies", "must list at least one policy");
-        v.require(
-            !self.creatures.is_empty() && self.creatures.windows(2).all(|w| w[0] < w[1]),
-            "creatures",
-            "must list crowd sizes, smallest first",
-        );
-        for (i, &n) in self.creatures.iter().enumerate() {
-            v.require(
-                (1..=simlod::config::MAX_CREATURES).contains(&n),
-                &format!("creatures[{i}]"),
-                format!(
-                    "must be between 1 and {} creatures, got {n}",
-                    simlod::config::MAX_CREATURES
-                ),
-            );
-        }
+        super::validate_crowd_sizes(v, &self.creatures);
         v.range("seconds", self.seconds, 1.0 / 30.0, 600.0);
         v.range("stop_frame_ms", self.stop_frame_ms, 1.0, 600_000.0);
     }
@@ -173,10 +159,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             colour,
         ));
     }
-    let (lo, hi) = (
-        f64::from(s.creatures[0]).log10(),
-        f64::from(*s.creatures.last().expect("validated: not empty")).log10(),
-    );
+    let (lo, hi) = super::log10_span(&s.creatures);
     series.push(Series::new(
         "1/30 s: 30 fps",
         vec![(lo, 1e3 / 30.0), (hi, 1e3 / 30.0)],

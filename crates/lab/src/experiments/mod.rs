@@ -290,6 +290,32 @@ pub fn mean_and_variance(values: &[f64]) -> (f64, f64) {
     (mean, variance)
 }
 
+/// Checks a list of crowd sizes: at least one, smallest first, each a creature count the
+/// simulation takes.
+pub fn validate_crowd_sizes(v: &mut Validator, creatures: &[u32]) {
+    v.require(
+        !creatures.is_empty() && creatures.windows(2).all(|w| w[0] < w[1]),
+        "creatures",
+        "must list crowd sizes, smallest first",
+    );
+    for (i, &n) in creatures.iter().enumerate() {
+        v.require(
+            (1..=simlod::config::MAX_CREATURES).contains(&n),
+            &format!("creatures[{i}]"),
+            format!(
+                "must be between 1 and {} creatures, got {n}",
+                simlod::config::MAX_CREATURES
+            ),
+        );
+    }
+}
+
+/// The smallest and largest of validated crowd sizes, as log10: a plot's span.
+pub fn log10_span(creatures: &[u32]) -> (f64, f64) {
+    let log = |n: &u32| f64::from(*n).log10();
+    (creatures.first().map_or(0.0, log), creatures.last().map_or(0.0, log))
+}
+
 /// The 99th percentile of frame times given in seconds, in ms.
 pub fn p99_ms(frames_s: &[f64]) -> f64 {
     let mut sorted = frames_s.to_vec();
