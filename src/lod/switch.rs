@@ -85,17 +85,20 @@ fn switch_levels(
     // another level or might be forced to rigid (in the query's order, so the switches come in
     // the same order as a pass over every creature). Of those that waited for their window
     // last tick, the others let go of the drawing they kept.
+    let attends = |lod: Lod, choice: &LevelChoice, record: &CollisionRecord| {
+        let may_be_forced = rules_move_levels && lod != Lod::Rigid && record.touching.iter().any(|&t| t);
+        choice.wanted != lod || may_be_forced
+    };
     let (attend, waiting) = &mut *kept;
     attend.clear();
     for (entity, _, lod, choice, _, record, _) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
         let rows = entity.iter().zip(lod).zip(choice).zip(record);
-        attend.extend(rows.filter_map(|(((&e, &lod), choice), record)| {
-            let may_be_forced = rules_move_levels && lod != Lod::Rigid && record.touching.iter().any(|&t| t);
-            (choice.wanted != lod || may_be_forced).then_some(e)
-        }));
+        attend.extend(rows.filter_map(|(((&e, &lod), choice), record)| attends(lod, choice, record).then_some(e)));
     }
-    for entity in waiting.drain(..).filter(|e| !attend.contains(e)) {
-        if let Ok((.., (_, _, _, mut before))) = creatures.get_mut(entity) {
+    for entity in waiting.drain(..) {
+        if let Ok((_, _, &lod, choice, _, record, (_, _, _, mut before))) = creatures.get_mut(entity)
+            && !attends(lod, &choice, record)
+        {
             before.0 = None;
         }
     }

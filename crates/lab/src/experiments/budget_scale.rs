@@ -75,6 +75,12 @@ impl Game {
     fn mean_over_budget(&self) -> f64 {
         self.mean_frame_ms / f64::from(self.budget_ms)
     }
+
+    /// Whether the budget was kept: the mean frame within 10 % of it, the 99th percentile
+    /// within 25 %.
+    fn kept(&self) -> bool {
+        self.mean_frame_ms <= 1.1 * f64::from(self.budget_ms) && self.p99_frame_ms <= 1.25 * f64::from(self.budget_ms)
+    }
 }
 
 fn game(config: &SimConfig, s: &BudgetScaleSettings, creatures: u32, budget_ms: f32, adaptive_frames: f32) -> Game {
@@ -207,7 +213,6 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
         s.seed, s.seconds
     );
     for g in games {
-        let kept = g.mean_frame_ms <= 1.1 * f64::from(g.budget_ms) && g.p99_frame_ms <= 1.25 * f64::from(g.budget_ms);
         let _ = writeln!(
             report,
             "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {} of {} | {:.0} | {:.0} |",
@@ -221,17 +226,14 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
             g.mean_frame_ms,
             g.p99_frame_ms,
             g.predicted_mean_ms,
-            if kept { "yes" } else { "no" },
+            if g.kept() { "yes" } else { "no" },
             g.decisions_over_budget,
             g.decisions,
             g.hybrid,
             g.rigid
         );
     }
-    let kept = games
-        .iter()
-        .filter(|g| g.mean_frame_ms <= 1.1 * f64::from(g.budget_ms) && g.p99_frame_ms <= 1.25 * f64::from(g.budget_ms))
-        .count();
+    let kept = games.iter().filter(|g| g.kept()).count();
     let _ = write!(report, "\nKept in {kept} of {} games.\n", games.len());
     report
 }
