@@ -20,11 +20,16 @@ pub struct CostModel {
     /// without it predicts 0.
     #[serde(default)]
     pub fixed_us_per_frame: f32,
-    /// What the budget policy's own choice costs per creature per 1/30 s (its benefits and
-    /// the knapsack), in microseconds: taken from the budget with the fixed cost. A file
-    /// without it predicts 0.
+    /// What the budget policy's own choice costs per creature per 1/30 s (its benefits short
+    /// of the search for contacts with other creatures, and the knapsack), in microseconds:
+    /// taken from the budget with the fixed cost. A file without it predicts 0.
     #[serde(default)]
     pub decision_us_per_creature: f32,
+    /// What the choice's search for one creature's soonest contact with another costs, in
+    /// microseconds: taken from the budget for each creature searched (only those that could
+    /// still buy a level are). A file without it predicts 0.
+    #[serde(default)]
+    pub contact_search_us: f32,
 }
 
 /// A kind's costs, by name.
@@ -114,6 +119,7 @@ impl Validate for CostModel {
             0.0,
             LevelCosts::MOST_US,
         );
+        v.within("contact_search_us", self.contact_search_us, 0.0, LevelCosts::MOST_US);
     }
 }
 

@@ -73,6 +73,11 @@ pub struct BudgetRules {
     pub cost_model: String,
     /// A contact this many seconds away is worth 1/e of one now; 0.01 to 60 s.
     pub contact_horizon_s: f32,
+    /// A creature's search for its soonest contact with another creature stands this long
+    /// before it is searched again (the choice's dearest part, in a crowd); 0 searches at every
+    /// decision, as a file without it does; 0 to 10 s.
+    #[serde(default)]
+    pub contact_recheck_s: f32,
     /// Bodies count as touching this much before their footprints meet; 0 to 100 m.
     pub contact_margin_m: f32,
     /// The earliest contact possible (both turning toward each other at full speed) counts
@@ -135,6 +140,7 @@ impl Validate for LevelRules {
             v.range("frame_budget_ms", b.frame_budget_ms, 0.0, 10_000.0);
             v.asset_path("cost_model", &b.cost_model);
             v.range("contact_horizon_s", b.contact_horizon_s, 0.01, 60.0);
+            v.range("contact_recheck_s", b.contact_recheck_s, 0.0, 10.0);
             v.range("contact_margin_m", b.contact_margin_m, 0.0, 100.0);
             v.within("worst_case_share", b.worst_case_share, 0.0, 1.0);
             for (field, w) in [

@@ -52,8 +52,11 @@ pub struct Candidate<'a> {
     pub levels: &'a [Lod],
     /// What each of its levels costs, us per 1/30 s.
     pub costs: LevelCosts,
-    /// Benefit of each level, indexed by `Lod as usize`.
+    /// Benefit of each level, indexed by `Lod as usize`. Until `settled`, the rigid level's is
+    /// only the most it can be.
     pub benefit: [f32; 3],
+    /// Whether `benefit` is exact; if not, [`allocate`] settles it when it must know.
+    pub settled: bool,
 }
 
 impl Candidate<'_> {
@@ -78,6 +81,43 @@ impl Candidate<'_> {
         let b = self.benefit[level as usize];
         if level == self.last { b * (1.0 + hysteresis) } else { b }
     }
+
+    /// The next step up its upper hull of cost and benefit from `at`: the most benefit per
+    /// microsecond, ties to the lower level; none below `least_per_us`.
+    fn step_from(&self, creature: usize, at: Lod, hysteresis: f32, least_per_us: f32) -> Option<Step> {
+        let (cost, value) = (self.cost_us(at), self.value(at, hysteresis));
+        self.levels
+            .iter()
+            .copied()
+            .filter(|&l| l > at && self.value(l, hysteresis) > value)
+            .map(|to| {
+                let extra_us = self.cost_us(to) - cost;
+                let gain = self.value(to, hysteresis) - value;
+                let ratio = if extra_us > 0.0 { gain / extra_us } else { f32::INFINITY };
+                Step {
+                    ratio,
+                    // Only the rigid benefit is ever a bound: a step to another level is exact.
+                    bound: !self.settled && to == Lod::Rigid,
+                    serial: self.serial,
+                    creature,
+                    from: at,
+                    to,
+                    extra_us,
+                }
+            })
+            .max_by(|a, b| a.ratio.total_cmp(&b.ratio).then(b.to.cmp(&a.to)))
+            .filter(|s| s.ratio >= least_per_us)
+    }
+
+    /// The least any step up from `at` can cost.
+    fn cheapest_step_us(&self, at: Lod) -> f32 {
+        let from_us = self.cost_us(at);
+        self.levels
+            .iter()
+            .filter(|&&l| l > at)
+            .map(|&l| self.cost_us(l) - from_us)
+            .fold(f32::INFINITY, f32::min)
+    }
 }
 
 /// The levels chosen, and what the frame is predicted to cost.
@@ -89,16 +129,49 @@ pub struct Allocation {
     pub predicted_us: f32,
     /// Even the cheapest allowed levels cost more than the budget.
     pub exceeded: bool,
+    /// Candidates whose benefit had to be settled (each one's search for contacts).
+    pub settled: usize,
 }
 
-/// One step up a creature's levels on the knapsack's upper hull.
+/// One step up a creature's levels on the knapsack's upper hull; while `bound`, its ratio is
+/// only the most any of the creature's steps can have.
+#[derive(Clone, Copy, Debug)]
 struct Step {
     ratio: f32,
+    bound: bool,
+    serial: u32,
     creature: usize,
     from: Lod,
     to: Lod,
     extra_us: f32,
 }
+
+/// The order steps are taken in: the most benefit per microsecond first, a bound before an
+/// exact step of the same ratio (it may turn out as good), then the lower serial, the lower
+/// level.
+impl Ord for Step {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.ratio
+            .total_cmp(&other.ratio)
+            .then(self.bound.cmp(&other.bound))
+            .then(other.serial.cmp(&self.serial))
+            .then(other.to.cmp(&self.to))
+    }
+}
+
+impl PartialOrd for Step {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl PartialEq for Step {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Step {}
 
 /// Chooses a level for each candidate: from each one's floor, the steps up with the most
 /// benefit per microsecond first, while the budget allows (a multiple-choice knapsack solved
@@ -107,83 +180,121 @@ struct Step {
 /// a creature going down keeps costing its old level until its flight window, the last steps
 /// taken are given back until the frame as it will run fits. Deterministic: ties go to the
 /// lower serial.
-pub fn allocate(candidates: &[Candidate], budget_us: f32, hysteresis: f32, least_per_us: f32) -> Allocation {
+///
+/// Incremental (after Funkhouser & Sequin): a candidate not yet `settled` waits in the queue
+/// at the most its steps could be worth, and is settled by `settle` (its exact rigid benefit,
+/// charged `settle_us` of the budget) only when it reaches the front with room left for a
+/// step of its own. Since a bound is never below what it bounds, the steps are taken in the
+/// same order as if every benefit had been exact from the start.
+pub fn allocate(
+    candidates: &mut [Candidate],
+    budget_us: f32,
+    hysteresis: f32,
+    least_per_us: f32,
+    settle_us: f32,
+    mut settle: impl FnMut(usize) -> f32,
+) -> Allocation {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
-    let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
-    let mut steps = Vec::new();
-    for (i, c) in candidates.iter().enumerate() {
-        let mut at = c.floor;
-        loop {
-            let (cost, value) = (c.cost_us(at), c.value(at, hysteresis));
-            let best = c
-                .levels
-                .iter()
-                .copied()
-                .filter(|&l| l > at && c.value(l, hysteresis) > value)
-                .map(|l| {
-                    let extra = c.cost_us(l) - cost;
-                    let gain = c.value(l, hysteresis) - value;
-                    (if extra > 0.0 { gain / extra } else { f32::INFINITY }, l, extra)
-                })
-                .max_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
-            let Some((ratio, to, extra_us)) = best.filter(|b| b.0 >= least_per_us) else {
-                break;
-            };
-            steps.push(Step {
-                ratio,
-                creature: i,
-                from: at,
-                to,
-                extra_us,
-            });
-            at = to;
-        }
+    let (mut spent, cheapest_us) = floors_and_cheapest_step_us(candidates);
+    // Each creature's first step, best first, then what follows a step (few): merged.
+    let mut firsts = Vec::new();
+    if spent + cheapest_us <= budget_us {
+        firsts = candidates
+            .iter()
+            .enumerate()
+            .filter_map(|(i, c)| c.step_from(i, c.floor, hysteresis, least_per_us))
+            .collect();
+        firsts.sort_unstable_by(|a, b| b.cmp(a));
     }
-    steps.sort_by(|a, b| {
-        b.ratio
-            .total_cmp(&a.ratio)
-            .then(candidates[a.creature].serial.cmp(&candidates[b.creature].serial))
-            .then(a.to.cmp(&b.to))
-    });
-    let mut taken = Vec::new();
-    for step in &steps {
-        if levels[step.creature] == step.from && spent + step.extra_us <= budget_us {
+    let mut firsts = firsts.into_iter().peekable();
+    let mut follows = std::collections::BinaryHeap::new();
+    let (mut taken, mut settled) = (Vec::new(), 0);
+    // The frame as it will run (creatures going down still cost their level): a search is
+    // paid for at once and never given back, so it must fit beside that too.
+    let mut running_us: f32 = candidates.iter().map(|c| c.frame_cost_us(c.floor)).sum();
+    loop {
+        let step = match (firsts.peek(), follows.peek()) {
+            (Some(first), Some(follow)) if follow > first => follows.pop(),
+            (Some(_), _) => firsts.next(),
+            (None, _) => follows.pop(),
+        };
+        let Some(step) = step else { break };
+        if spent + cheapest_us > budget_us {
+            break;
+        }
+        let c = &mut candidates[step.creature];
+        if step.bound {
+            // Worth settling only with room for the search and a step after it.
+            let paid_for = settle_us == 0.0 || running_us + settle_us <= budget_us;
+            if paid_for && spent + settle_us + c.cheapest_step_us(step.from) <= budget_us {
+                spent += settle_us;
+                running_us += settle_us;
+                settled += 1;
+                c.benefit[Lod::Rigid as usize] = settle(step.creature);
+                c.settled = true;
+                follows.extend(c.step_from(step.creature, step.from, hysteresis, least_per_us));
+            }
+        } else if spent + step.extra_us <= budget_us {
             levels[step.creature] = step.to;
             spent += step.extra_us;
+            running_us += c.frame_cost_us(step.to) - c.frame_cost_us(step.from);
             taken.push(step);
+            follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us));
         }
     }
-    let frame = |levels: &[Lod]| -> f32 { candidates.iter().zip(levels).map(|(c, &l)| c.frame_cost_us(l)).sum() };
+    let searched_us = settled as f32 * settle_us;
+    let frame = |levels: &[Lod]| -> f32 {
+        searched_us
+            + candidates
+                .iter()
+                .zip(levels)
+                .map(|(c, &l)| c.frame_cost_us(l))
+                .sum::<f32>()
+    };
     let mut predicted_us = frame(&levels);
+    let mut given_back = false;
     for step in taken.iter().rev() {
         if predicted_us <= budget_us {
             break;
         }
+        let c = &candidates[step.creature];
         levels[step.creature] = step.from;
+        predicted_us += c.frame_cost_us(step.from) - c.frame_cost_us(step.to);
+        given_back = true;
+    }
+    // Summed afresh once, so that the steps' rounding does not add up.
+    if given_back {
         predicted_us = frame(&levels);
     }
     Allocation {
         levels,
         predicted_us,
         exceeded: predicted_us > budget_us,
+        settled,
     }
 }
 
-/// Whether any creature's cheapest step up from its floor fits in `budget_us` beside every
-/// creature at its floor: if not, [`allocate`] gives every creature its floor.
-fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
-    let floors_us: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
-    let cheapest_step_us = candidates
+/// What every creature costs at its floor, and the least any step up can cost: once the room
+/// left is below that, the choice is over.
+fn floors_and_cheapest_step_us(candidates: &[Candidate]) -> (f32, f32) {
+    let floors_us = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
+    let cheapest_us = candidates
         .iter()
         .flat_map(|c| {
-            let floor_us = c.cost_us(c.floor);
             c.levels
                 .iter()
-                .filter(move |&&l| l > c.floor)
-                .map(move |&l| c.cost_us(l) - floor_us)
+                .filter(|&&l| l >= c.floor)
+                .map(|&l| c.cheapest_step_us(l))
         })
         .fold(f32::INFINITY, f32::min);
-    floors_us + cheapest_step_us <= budget_us
+    (floors_us, cheapest_us)
+}
+
+/// Whether any creature's cheapest step up fits in `budget_us` beside every creature at its
+/// floor: if not, [`allocate`] gives every creature its floor.
+fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
+    let (floors_us, cheapest_us) = floors_and_cheapest_step_us(candidates);
+    floors_us + cheapest_us <= budget_us
 }
 
 /// The adaptive mode's correction of the cost model after one more measured frame: the
@@ -219,6 +330,8 @@ pub struct BudgetTally {
     pub predicted_sum_us: f64,
     /// The slowest predicted frame, us.
     pub predicted_max_us: f32,
+    /// Creatures searched for contacts with others, over all decisions.
+    pub searched: u64,
 }
 
 /// The budget policy's run, in the summary.
@@ -234,6 +347,9 @@ pub struct BudgetSummary {
     pub decisions: u64,
     /// Decisions where even the cheapest levels allowed were predicted over the budget.
     pub decisions_over_budget: u64,
+    /// Creatures searched for contacts with other creatures per decision, on average (the
+    /// choice searches only those that could still buy a level).
+    pub searched_per_decision: f64,
     /// Whether the adaptive mode corrected the cost model (the run is then not reproducible),
     /// and its last correction (measured over predicted; 1 when off).
     pub adaptive: bool,
@@ -251,6 +367,7 @@ impl Default for BudgetTally {
             over_budget: 0,
             predicted_sum_us: 0.0,
             predicted_max_us: 0.0,
+            searched: 0,
         }
     }
 }
@@ -270,6 +387,7 @@ impl BudgetTally {
             predicted_ms_max: self.predicted_max_us / 1e3,
             decisions: self.decisions,
             decisions_over_budget: self.over_budget,
+            searched_per_decision: self.searched as f64 / self.decisions.max(1) as f64,
             adaptive: rules.adaptive_frames > 0.0,
             correction: self.correction,
         }
@@ -279,6 +397,7 @@ impl BudgetTally {
         self.model_us = a.predicted_us;
         self.decisions += 1;
         self.over_budget += u64::from(a.exceeded);
+        self.searched += a.settled as u64;
         self.predicted_sum_us += f64::from(self.predicted_us());
         self.predicted_max_us = self.predicted_max_us.max(self.predicted_us());
     }
@@ -338,8 +457,9 @@ impl Scene<'_> {
         self.urgency(t, gap / closing.max(1e-3))
     }
 
-    /// Benefit of the rigid level from how soon a contact could come.
-    fn contact(&self, c: &Creature, s: &PlanarState, radius: f32) -> f32 {
+    /// How urgent a contact is with the puck, the host's areas or a wall (the rigid level's
+    /// benefit from contacts, before other creatures are searched).
+    fn near(&self, s: &PlanarState, radius: f32) -> f32 {
         let (r, margin) = (self.rules, self.rules.contact_margin_m);
         let mut best = 0.0f32;
         // The puck, and the host's areas of influence.
@@ -362,38 +482,40 @@ impl Scene<'_> {
         };
         let t = course(room.x, along.x).min(course(room.y, along.y));
         let gap = room.min_element().max(0.0);
-        best = best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)));
+        best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)))
+    }
+
+    /// How urgent the soonest contact with another creature is (0 to 1).
+    fn crowding(&self, c: &Creature, s: &PlanarState, radius: f32) -> f32 {
+        let margin = self.rules.contact_margin_m;
         // Other creatures: urgency falls with time, so only the soonest contacts count (one
         // urgency per creature, not one per neighbour).
         // Nearest first: beyond a ring, a creature is at least `gap` away and closes at most at
         // the fastest speeds, so once that bound is worth no more than the soonest contact
         // found, the rest cannot change it (the same value as a search of the whole reach).
-        if r.creature_weight > 0.0 {
-            let (t_course, t_worst) = (Cell::new(f32::INFINITY), Cell::new(f32::INFINITY));
-            let closing = (2.0 * self.top_speed).max(1e-3);
-            let (fastest, widest) = self.grid.fastest_and_widest();
-            let closing_on_course = (s.velocity.length() + fastest).max(1e-3);
-            self.grid.for_each_nearest_first(
-                s.position,
-                NEAREST_RING_M,
-                self.reach_m,
-                |n| {
-                    if n.serial == c.serial {
-                        return;
-                    }
-                    let d = s.position - n.position;
-                    let reach = radius + n.radius + margin;
-                    t_worst.set(t_worst.get().min((d.length() - reach).max(0.0) / closing));
-                    t_course.set(t_course.get().min(time_to_contact(d, s.velocity - n.velocity, reach)));
-                },
-                |ring| {
-                    let gap = (ring - (radius + widest + margin)).max(0.0);
-                    self.urgency(gap / closing_on_course, gap / closing) <= self.urgency(t_course.get(), t_worst.get())
-                },
-            );
-            best = best.max(r.creature_weight * self.urgency(t_course.get(), t_worst.get()));
-        }
-        best
+        let (t_course, t_worst) = (Cell::new(f32::INFINITY), Cell::new(f32::INFINITY));
+        let closing = (2.0 * self.top_speed).max(1e-3);
+        let (fastest, widest) = self.grid.fastest_and_widest();
+        let closing_on_course = (s.velocity.length() + fastest).max(1e-3);
+        self.grid.for_each_nearest_first(
+            s.position,
+            NEAREST_RING_M,
+            self.reach_m,
+            |n| {
+                if n.serial == c.serial {
+                    return;
+                }
+                let d = s.position - n.position;
+                let reach = radius + n.radius + margin;
+                t_worst.set(t_worst.get().min((d.length() - reach).max(0.0) / closing));
+                t_course.set(t_course.get().min(time_to_contact(d, s.velocity - n.velocity, reach)));
+            },
+            |ring| {
+                let gap = (ring - (radius + widest + margin)).max(0.0);
+                self.urgency(gap / closing_on_course, gap / closing) <= self.urgency(t_course.get(), t_worst.get())
+            },
+        );
+        self.urgency(t_course.get(), t_worst.get())
     }
 
     /// How much the viewer sees of a creature: 0 out of view, 1 at the camera, halving at
@@ -406,8 +528,10 @@ impl Scene<'_> {
         }
     }
 
-    /// Benefit of each level for one creature.
-    fn benefit(&self, entity: Entity, c: &Creature, s: &PlanarState, kind: &KindParams) -> [f32; 3] {
+    /// What one creature's levels are worth before its search for contacts with other
+    /// creatures: exact for the point mass and the hybrid, the most it can be for the rigid
+    /// level, unless the puck, an area or a wall already outweighs any other creature.
+    fn bounds(&self, entity: Entity, s: &PlanarState, kind: &KindParams) -> Bounds {
         let r = self.rules;
         let view = self.view(kind, s);
         let hybrid = r.view_hybrid_weight * view;
@@ -416,8 +540,33 @@ impl Scene<'_> {
         } else {
             0.0
         };
-        let rigid = hybrid + r.view_rigid_weight * view + followed + self.contact(c, s, kind.radius_m);
-        [0.0, hybrid, rigid]
+        Bounds {
+            hybrid,
+            seen: hybrid + r.view_rigid_weight * view + followed,
+            near: self.near(s, kind.radius_m),
+        }
+    }
+}
+
+/// One creature's benefits before its search for contacts with other creatures.
+#[derive(Clone, Copy, Debug, Default)]
+struct Bounds {
+    hybrid: f32,
+    /// The rigid level's benefit from the view and the player.
+    seen: f32,
+    /// The rigid level's from the puck, the areas and the walls.
+    near: f32,
+}
+
+impl Bounds {
+    /// The rigid level's benefit with contacts with other creatures at `crowding`.
+    fn rigid(&self, rules: &BudgetRules, crowding: f32) -> f32 {
+        self.seen + self.near.max(rules.creature_weight * crowding)
+    }
+
+    /// Whether no other creature can change the rigid level's benefit.
+    fn settled(&self, rules: &BudgetRules) -> bool {
+        self.near >= rules.creature_weight
     }
 }
 
@@ -433,6 +582,35 @@ type Creatures<'w, 's> = Query<
     ),
 >;
 
+/// One decision of the budget policy, in the query's order.
+struct Decision {
+    entities: Vec<Entity>,
+    allocation: Allocation,
+    /// The creatures searched for contacts with others (by their place in the query, in
+    /// order), and how urgent their soonest contact is.
+    searched: Vec<(usize, f32)>,
+}
+
+impl Decision {
+    /// Keeps a creature's search for `contact_recheck_s`: its choice's new level, and its
+    /// search if it had one.
+    fn write(
+        &self,
+        searched: &mut std::iter::Peekable<std::slice::Iter<(usize, f32)>>,
+        row: usize,
+        now_s: f32,
+        choice: &mut Mut<LevelChoice>,
+    ) {
+        let level = self.allocation.levels[row];
+        if choice.wanted != level {
+            choice.wanted = level;
+        }
+        if let Some(&(_, urgency)) = searched.next_if(|s| s.0 == row) {
+            choice.crowding = Some((urgency, now_s));
+        }
+    }
+}
+
 /// The allocation for every creature now, in the query's order.
 fn decide(
     now_s: f32,
@@ -441,10 +619,10 @@ fn decide(
     scene: &Scene,
     creatures: &Creatures,
     budget_us: f32,
-) -> (Vec<Entity>, Allocation) {
+) -> Decision {
     let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
     let rows: Vec<_> = creatures.iter().collect();
-    let candidates: Vec<Candidate> = rows
+    let mut candidates: Vec<Candidate> = rows
         .iter()
         .map(|&(_, c, &lod, _, choice)| {
             let kind = &kinds[c.kind];
@@ -457,36 +635,63 @@ fn decide(
                 levels: &kind.levels,
                 costs: costs[c.kind],
                 benefit: [0.0; 3],
+                settled: true,
             }
         })
         .collect();
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let rules = &config.rules.budget;
     let room_us = budget_us - config.costs.overhead_us(candidates.len());
+    let (hysteresis, least_per_us) = (rules.hysteresis, rules.least_benefit_per_ms / 1e3);
     let entities = rows.iter().map(|r| r.0).collect();
     // Where not one step up fits, every creature keeps its floor whatever the benefits: they
     // are not worked out, and the choice costs next to nothing (a crowd far over its budget).
     if !any_step_fits(&candidates, room_us) {
-        let mut allocation = allocate(&candidates, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
+        let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, 0.0, |_| 0.0);
         allocation.predicted_us += config.costs.overhead_us(0);
-        return (entities, allocation);
+        return Decision {
+            entities,
+            allocation,
+            searched: Vec::new(),
+        };
     }
-    // In the order of the serials (ties go to the lower); each creature's benefit is its own,
-    // worked out across the cores (most of the choice's time).
+    // In the order of the serials (ties go to the lower); each creature's bounds are its own,
+    // worked out across the cores.
     let mut order: Vec<usize> = (0..rows.len()).collect();
     order.sort_unstable_by_key(|&i| rows[i].1.serial);
     let mut by_serial: Vec<Candidate> = order.iter().map(|&i| candidates[i].clone()).collect();
+    let mut bounds = vec![Bounds::default(); rows.len()];
     let n = chunk_len(config.scenario.creature_count(), rows.len());
-    run_chunks(order.chunks(n).zip(by_serial.chunks_mut(n)).map(|(order, candidates)| {
-        let rows = &rows;
-        move || {
-            for (&i, candidate) in order.iter().zip(candidates) {
-                let (entity, c, _, s, _) = rows[i];
-                candidate.benefit = scene.benefit(entity, c, s, &kinds[c.kind]);
-            }
-        }
-    }));
-    let mut allocation = allocate(&by_serial, room_us, rules.hysteresis, rules.least_benefit_per_ms / 1e3);
+    run_chunks(
+        order
+            .chunks(n)
+            .zip(by_serial.chunks_mut(n))
+            .zip(bounds.chunks_mut(n))
+            .map(|((order, candidates), bounds)| {
+                let rows = &rows;
+                move || {
+                    for ((&i, candidate), bound) in order.iter().zip(candidates).zip(bounds) {
+                        let (entity, c, _, s, choice) = rows[i];
+                        *bound = scene.bounds(entity, s, &kinds[c.kind]);
+                        // A search within `contact_recheck_s` stands; without one, any
+                        // contact with another creature could be now.
+                        let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
+                        candidate.benefit = [0.0, bound.hybrid, bound.rigid(rules, standing.map_or(1.0, |s| s.0))];
+                        candidate.settled = standing.is_some() || bound.settled(rules);
+                    }
+                }
+            }),
+    );
+    // Only a creature that could still buy a level is searched for contacts with the others.
+    let search_us = config.costs.contact_search_us;
+    let mut searched = Vec::new();
+    let mut allocation = allocate(&mut by_serial, room_us, hysteresis, least_per_us, search_us, |i| {
+        let (_, c, _, s, _) = rows[order[i]];
+        let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
+        searched.push((order[i], urgency));
+        bounds[i].rigid(rules, urgency)
+    });
+    searched.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
     // Back in the query's order.
     let mut levels = vec![Lod::PointMass; rows.len()];
@@ -494,7 +699,11 @@ fn decide(
         levels[i] = level;
     }
     allocation.levels = levels;
-    (entities, allocation)
+    Decision {
+        entities,
+        allocation,
+        searched,
+    }
 }
 
 fn scene<'a>(
@@ -525,7 +734,7 @@ fn scene<'a>(
 impl DecisionInputs<'_, '_> {
     /// The allocation for every creature now, in the query's order: within the budget as the
     /// cost model predicts it, times `correction`.
-    fn decide(&self, creatures: &Creatures, correction: f32) -> (Vec<Entity>, Allocation) {
+    fn decide(&self, creatures: &Creatures, correction: f32) -> Decision {
         let budget_us = self.config.rules.budget.frame_budget_ms * 1e3 / correction;
         let scene = scene(
             &self.config,
@@ -558,14 +767,23 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     {
         tally.correction = corrected(tally.correction, tally.model_us, measured_us, frames);
     }
-    let (_, allocation) = inputs.decide(&creatures, tally.correction);
-    tally.record(&allocation);
+    let decision = inputs.decide(&creatures, tally.correction);
+    tally.record(&decision.allocation);
     // In the query's order, as decided.
-    for ((.., mut choice), &level) in creatures.iter_mut().zip(&allocation.levels) {
-        if choice.wanted != level {
-            choice.wanted = level;
-        }
+    let now_s = inputs.clock.seconds() as f32;
+    let mut searched = decision.searched.iter().peekable();
+    for (row, (.., mut choice)) in creatures.iter_mut().enumerate() {
+        decision.write(&mut searched, row, now_s, &mut choice);
     }
+}
+
+/// The budget policy's choice for the world as it stands, at its rules' budget, without
+/// applying it: what `simlod bench --calibrate` times to measure the choice. None in a world
+/// without the simulation's resources.
+pub fn choice_now(world: &mut World) -> Option<Allocation> {
+    let mut state = bevy::ecs::system::SystemState::<(DecisionInputs, Creatures)>::new(world);
+    let (inputs, creatures) = state.get_mut(world).ok()?;
+    Some(inputs.decide(&creatures, 1.0).allocation)
 }
 
 /// A new world under the budget policy: its creatures, placed at the cheapest level, start at
@@ -582,8 +800,9 @@ fn start_by_budget(
         return;
     }
     let now = inputs.clock.seconds() as f32;
-    let (entities, allocation) = inputs.decide(&creatures, tally.correction);
-    for (&entity, &level) in entities.iter().zip(&allocation.levels) {
+    let decision = inputs.decide(&creatures, tally.correction);
+    let mut searched = decision.searched.iter().peekable();
+    for (row, (&entity, &level)) in decision.entities.iter().zip(&decision.allocation.levels).enumerate() {
         let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
             continue;
         };
@@ -593,7 +812,7 @@ fn start_by_budget(
             (*gait, *pose) = starting_gait(level, &inputs.kinds[c.kind], gait.cycle, now);
             commands.entity(entity).insert(level);
         }
-        choice.wanted = level;
+        decision.write(&mut searched, row, now, &mut choice);
     }
 }
 
@@ -636,6 +855,7 @@ mod tests {
             levels: &Lod::ALL,
             costs: COSTS,
             benefit: [0.0, 0.5, rigid_benefit],
+            settled: true,
         }
     }
 
@@ -646,10 +866,14 @@ mod tests {
         let floors = vec![Lod::PointMass; 3];
         for budget_us in [0.0, 2.0, 3.9] {
             assert!(!any_step_fits(&crowd, budget_us));
-            assert_eq!(allocate(&crowd, budget_us, 0.0, 0.0).levels, floors, "{budget_us} us");
+            assert_eq!(
+                allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 0.0, |_| 0.0).levels,
+                floors,
+                "{budget_us} us"
+            );
         }
         assert!(any_step_fits(&crowd, 4.0));
-        assert_ne!(allocate(&crowd, 4.0, 0.0, 0.0).levels, floors);
+        assert_ne!(allocate(&mut crowd.clone(), 4.0, 0.0, 0.0, 0.0, |_| 0.0).levels, floors);
         // A rigid creature dwelling at its level: its floor is rigid, its own cost counts.
         let dwelling = Candidate {
             floor: Lod::Rigid,
@@ -658,6 +882,117 @@ mod tests {
         let crowd = [crowd, vec![dwelling]].concat();
         assert!(!any_step_fits(&crowd, 103.9));
         assert!(any_step_fits(&crowd, 104.0));
+    }
+
+    /// A crowd of `n` with mixed levels and dwells, and each one's exact rigid benefit; half of
+    /// them are in view (a hybrid benefit), a few dearer (another kind).
+    fn mixed_crowd(n: u32) -> (Vec<Candidate<'static>>, Vec<f32>) {
+        let mut seed = 99u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut exact = Vec::new();
+        let crowd = (0..n)
+            .map(|i| {
+                let current = Lod::ALL[(next() * 3.0) as usize];
+                let hybrid = if next() < 0.5 { next() } else { 0.0 };
+                exact.push(hybrid + 2.0 * next());
+                Candidate {
+                    last: Lod::ALL[(next() * 3.0) as usize],
+                    floor: if next() < 0.2 { current } else { Lod::PointMass },
+                    costs: if i % 7 == 0 {
+                        LevelCosts {
+                            rigid_us_per_frame: 180.0,
+                            ..COSTS
+                        }
+                    } else {
+                        COSTS
+                    },
+                    // Unsettled: the most the rigid level could be worth.
+                    benefit: [0.0, hybrid, hybrid + 2.0],
+                    settled: false,
+                    ..candidate(1000 - i, current, 0.0)
+                }
+            })
+            .collect();
+        (crowd, exact)
+    }
+
+    #[test]
+    fn settling_only_the_creatures_that_reach_the_front_chooses_as_settling_them_all() {
+        let (crowd, exact) = mixed_crowd(300);
+        let settled_first: Vec<Candidate> = crowd
+            .iter()
+            .zip(&exact)
+            .map(|(c, &rigid)| Candidate {
+                benefit: [0.0, c.benefit[1], rigid],
+                settled: true,
+                ..c.clone()
+            })
+            .collect();
+        for (budget_us, hysteresis, least_per_us) in [(800.0, 0.0, 0.0), (3000.0, 0.2, 0.0), (20_000.0, 0.2, 0.005)] {
+            let whole = allocate(
+                &mut settled_first.clone(),
+                budget_us,
+                hysteresis,
+                least_per_us,
+                0.0,
+                |_| unreachable!("every benefit is exact"),
+            );
+            let mut asked = Vec::new();
+            let lazy = allocate(&mut crowd.clone(), budget_us, hysteresis, least_per_us, 0.0, |i| {
+                asked.push(i);
+                exact[i]
+            });
+            assert_eq!(lazy.levels, whole.levels, "{budget_us} us");
+            assert_eq!(lazy.predicted_us, whole.predicted_us);
+            assert_eq!(lazy.settled, asked.len());
+            // Each settled once, and under a small budget only a few.
+            asked.sort_unstable();
+            asked.dedup();
+            assert_eq!(asked.len(), lazy.settled);
+            if budget_us < 1000.0 {
+                assert!(lazy.settled < 30, "{} settled", lazy.settled);
+            }
+        }
+    }
+
+    #[test]
+    fn each_search_comes_off_the_budget_and_into_the_prediction() {
+        // All point masses now, so that the budget has room.
+        let (mut crowd, exact) = mixed_crowd(300);
+        for c in &mut crowd {
+            (c.current, c.floor) = (Lod::PointMass, Lod::PointMass);
+        }
+        let free = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 0.0, |i| exact[i]);
+        let charged = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 5.0, |i| exact[i]);
+        assert!(charged.settled > 0);
+        let at_levels: f32 = crowd
+            .iter()
+            .zip(&charged.levels)
+            .map(|(c, &l)| c.frame_cost_us(l))
+            .sum();
+        let searched = charged.settled as f32 * 5.0;
+        assert!(
+            (charged.predicted_us - (at_levels + searched)).abs() < 0.01,
+            "{charged:?}"
+        );
+        assert!(charged.predicted_us <= 3000.0);
+        // What the searches cost is not spent on levels.
+        let levels_us = |a: &Allocation| {
+            crowd
+                .iter()
+                .zip(&a.levels)
+                .map(|(c, &l)| c.frame_cost_us(l))
+                .sum::<f32>()
+        };
+        assert!(
+            levels_us(&charged) < levels_us(&free),
+            "{} {}",
+            levels_us(&charged),
+            levels_us(&free)
+        );
     }
 
     #[test]
@@ -729,7 +1064,12 @@ mod tests {
                 }
             });
             let whole = b.creature_weight * scene.urgency(t_course, t_worst);
-            assert_eq!(scene.contact(c, s, 0.35), whole, "creature {}", c.serial);
+            assert_eq!(
+                b.creature_weight * scene.crowding(c, s, 0.35),
+                whole,
+                "creature {}",
+                c.serial
+            );
             with_neighbours += usize::from(seen > 0);
         }
         assert!(with_neighbours > 2800);
@@ -755,7 +1095,7 @@ mod tests {
     fn the_budget_goes_to_the_most_benefit_per_cost_and_is_never_exceeded() {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Room for two going rigid and three hybrids (2 x (100 + 50) + 3 x 2 = 306).
-        let a = allocate(&cs, 310.0, 0.0, 0.0);
+        let a = allocate(&mut cs.clone(), 310.0, 0.0, 0.0, 0.0, |_| 0.0);
         assert_eq!(
             a.levels,
             [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]
@@ -767,7 +1107,7 @@ mod tests {
     fn a_level_that_gains_less_than_the_least_benefit_per_cost_is_not_bought_however_large_the_budget() {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Going rigid from hybrid gains i - 0.5 for 148 us; at 0.02 per us only i = 4 pays.
-        let a = allocate(&cs, 10_000.0, 0.0, 0.02);
+        let a = allocate(&mut cs.clone(), 10_000.0, 0.0, 0.02, 0.0, |_| 0.0);
         assert_eq!(
             a.levels,
             [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid]
@@ -783,7 +1123,7 @@ mod tests {
         // One rigid now, with no benefit left; one hybrid with a contact ahead. Going down in
         // the flight window, the first still costs its rigid level this frame: no room yet.
         let cs = [candidate(0, Lod::Rigid, 0.0), candidate(1, Lod::Hybrid, 5.0)];
-        let a = allocate(&cs, 160.0, 0.0, 0.0);
+        let a = allocate(&mut cs.clone(), 160.0, 0.0, 0.0, 0.0, |_| 0.0);
         assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid]);
         assert!(a.predicted_us <= 160.0, "{a:?}");
     }
@@ -806,7 +1146,7 @@ mod tests {
     #[test]
     fn too_small_a_budget_gives_the_cheapest_levels_and_says_so() {
         let cs: Vec<_> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
-        let a = allocate(&cs, 1.0, 0.0, 0.0);
+        let a = allocate(&mut cs.clone(), 1.0, 0.0, 0.0, 0.0, |_| 0.0);
         assert_eq!(a.levels, [Lod::PointMass; 3]);
         assert!(a.exceeded);
     }

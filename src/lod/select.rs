@@ -43,6 +43,9 @@ pub struct LevelChoice {
     pub last_switch_s: f32,
     /// Whether it has switched since it was spawned.
     pub switched: bool,
+    /// The budget policy's last search for its soonest contact with another creature: how
+    /// urgent it was (0 to 1), and when (simulated seconds).
+    pub crowding: Option<(f32, f32)>,
 }
 
 /// The camera of the camera rule: its eye and its view's frustum. Headless it follows a

@@ -162,6 +162,7 @@ fn switch_levels(
             wanted: target,
             last_switch_s: now,
             switched: true,
+            ..*choice
         };
     }
 }

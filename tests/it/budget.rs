@@ -27,6 +27,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         other_kinds: COSTS,
         fixed_us_per_frame: 0.0,
         decision_us_per_creature: 0.0,
+        contact_search_us: 0.0,
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config
@@ -293,5 +294,31 @@ fn a_bad_cost_model_or_a_missing_one_is_refused_naming_the_file_and_the_field() 
     assert!(
         text.contains("`budget.cost_model`") && text.contains("gone.ron"),
         "{text}"
+    );
+}
+
+#[test]
+fn a_search_for_contacts_with_other_creatures_stands_for_the_recheck_time_and_is_paid_from_the_budget() {
+    // 60 hoppers, room for about twenty rigid: searches per decision and rigid creatures.
+    let run = |recheck_s: f32, search_us: f32| {
+        let mut config = budget_scene(60, 3.0);
+        config.rules.budget.contact_recheck_s = recheck_s;
+        config.costs.contact_search_us = search_us;
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(5.0);
+        let summary = sim.summary(0.0);
+        let budget = summary.budget.expect("a budget summary");
+        assert_eq!(budget.decisions_over_budget, 0);
+        (budget.searched_per_decision, summary.levels_mean[Lod::Rigid])
+    };
+    let (every_decision, rigid) = run(0.0, 0.0);
+    let (standing, _) = run(0.5, 0.0);
+    assert!(every_decision > 10.0, "{every_decision} searched a decision");
+    assert!(standing < every_decision / 3.0, "{standing} against {every_decision}");
+    // Searches at 50 us each leave less of the budget for rigid creatures.
+    let (_, rigid_with_dear_searches) = run(0.0, 50.0);
+    assert!(
+        rigid_with_dear_searches < rigid,
+        "{rigid_with_dear_searches} against {rigid}"
     );
 }

@@ -97,8 +97,8 @@ impl BenchArgs {
                 );
             }
             println!(
-                "  a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.2}",
-                model.fixed_us_per_frame, model.decision_us_per_creature
+                "  a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
+                model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
             );
         }
         Ok(())

@@ -316,18 +316,45 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
         other_kinds,
         fixed_us_per_frame: fixed_us as f32,
         decision_us_per_creature: 0.0,
+        contact_search_us: 0.0,
     };
-    // The budget policy's own choice: the scenario's crowd choosing under this model with a
-    // budget below the fixed cost (so every creature keeps its cheapest level), against the
-    // same crowd all point masses.
-    let mut choosing = config.clone();
-    (choosing.costs, choosing.rules.budget.frame_budget_ms) = (model.clone(), 0.0);
-    let decision_us = (frame_us(&choosing, cheap_count, LevelPolicy::Budget, runs, frames)
-        - frame_us(config, cheap_count, LevelPolicy::AllPointMass, runs, frames))
-    .max(0.0)
-        / f64::from(cheap_count);
-    model.decision_us_per_creature = decision_us as f32;
+    let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, warmup, frames);
+    (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
     model
+}
+
+/// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up,
+/// with room for every creature's every step (so nothing is left out): the microseconds per
+/// creature without the search for contacts between creatures (the creatures' weight at 0,
+/// so none needs it), and the microseconds per creature searched.
+fn choice_cost_us(config: &SimConfig, model: &CostModel, count: u32, warmup: usize, calls: usize) -> (f64, f64) {
+    let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
+    for _ in 0..warmup {
+        sim.advance_frame();
+    }
+    let mut time_choice = |creature_weight: f32| {
+        let world = sim.app.world_mut();
+        let mut sim_config = world.resource_mut::<SimConfig>();
+        (sim_config.costs, sim_config.rules.budget.frame_budget_ms) = (model.clone(), f32::MAX);
+        sim_config.rules.budget.creature_weight = creature_weight;
+        let mut searched = 0;
+        let us = median(
+            (0..calls)
+                .map(|_| {
+                    let start = Instant::now();
+                    searched = simlod::lod::choice_now(world).map_or(0, |a| a.settled);
+                    start.elapsed().as_secs_f64() * 1e6
+                })
+                .collect(),
+        );
+        (us, searched)
+    };
+    let (unsearched_us, _) = time_choice(0.0);
+    let (searched_us, searched) = time_choice(config.rules.budget.creature_weight);
+    (
+        unsearched_us / f64::from(count.max(1)),
+        (searched_us - unsearched_us).max(0.0) / searched.max(1) as f64,
+    )
 }
 
 /// Microseconds per switch into the rigid level (building a creature's bodies): a world of
