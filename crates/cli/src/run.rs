@@ -162,8 +162,8 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
             "within the budget".to_owned()
         };
         println!(
-            "frame budget {} ms of simulation per 1/30 s: as the policy chose, predicted {:.3} ms on average and {:.3} ms at most, {chosen}{adaptive}; measured {measured_ms:.3} ms of wall time on average, {kept}",
-            b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max
+            "frame budget {} ms of simulation per 1/30 s: as the policy chose, predicted {:.3} ms on average and {:.3} ms at most, {chosen}{adaptive}; {:.1} creatures searched for contacts a decision; measured {measured_ms:.3} ms of wall time on average, {kept}",
+            b.frame_budget_ms, b.predicted_ms_mean, b.predicted_ms_max, b.searched_per_decision
         );
     }
     for p in &s.pops {
