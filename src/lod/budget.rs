@@ -109,6 +109,23 @@ impl Candidate<'_> {
             .filter(|s| s.ratio >= least_per_us)
     }
 
+    /// Its steps up its upper hull from its floor, in turn.
+    fn hull(&self, creature: usize, hysteresis: f32, least_per_us: f32) -> impl Iterator<Item = Step> + '_ {
+        std::iter::successors(
+            self.step_from(creature, self.floor, hysteresis, least_per_us),
+            move |s| self.step_from(creature, s.to, hysteresis, least_per_us),
+        )
+    }
+
+    /// The least any step up from its floor or a level above can cost.
+    fn cheapest_step_above_floor_us(&self) -> f32 {
+        self.levels
+            .iter()
+            .filter(|&&l| l >= self.floor)
+            .map(|&l| self.cheapest_step_us(l))
+            .fold(f32::INFINITY, f32::min)
+    }
+
     /// The least any step up from `at` can cost.
     fn cheapest_step_us(&self, at: Lod) -> f32 {
         let from_us = self.cost_us(at);
@@ -146,16 +163,24 @@ struct Step {
     extra_us: f32,
 }
 
-/// The order steps are taken in: the most benefit per microsecond first, a bound before an
-/// exact step of the same ratio (it may turn out as good), then the lower serial, the lower
-/// level.
+/// The order steps are taken in, greatest first: the most benefit per microsecond, then the
+/// lower serial, then the lower level (a creature's steps up its hull in turn).
 impl Ord for Step {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
         self.ratio
             .total_cmp(&other.ratio)
-            .then(self.bound.cmp(&other.bound))
             .then(other.serial.cmp(&self.serial))
             .then(other.to.cmp(&self.to))
+    }
+}
+
+impl Step {
+    /// The same order as a key, smallest first, short of the level: steps sorted by it stably,
+    /// in the order of each creature's hull, are in [`Ord`]'s order.
+    fn order_key(&self) -> u64 {
+        let bits = self.ratio.to_bits();
+        let ascending = if bits >> 31 == 1 { !bits } else { bits | 0x8000_0000 };
+        (u64::from(!ascending) << 32) | u64::from(self.serial)
     }
 }
 
@@ -195,32 +220,40 @@ pub fn allocate(
     mut settle: impl FnMut(usize) -> f32,
 ) -> Allocation {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
-    let (mut spent, cheapest_us) = floors_and_cheapest_step_us(candidates);
-    // Each creature's first step, best first, then what follows a step (few): merged.
-    let mut firsts = Vec::new();
-    if spent + cheapest_us <= budget_us {
-        firsts = candidates
-            .iter()
-            .enumerate()
-            .filter_map(|(i, c)| c.step_from(i, c.floor, hysteresis, least_per_us))
-            .collect();
-        firsts.sort_unstable_by(|a, b| b.cmp(a));
+    let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
+    // Every creature's steps up its hull (two at most), and the cheapest step of all.
+    let mut listed = Vec::with_capacity(2 * candidates.len());
+    let mut cheapest_us = f32::INFINITY;
+    for (i, c) in candidates.iter().enumerate() {
+        cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us());
+        listed.extend(c.hull(i, hysteresis, least_per_us));
     }
-    let mut firsts = firsts.into_iter().peekable();
+    // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
+    // a heap beside them.
+    if spent + cheapest_us <= budget_us {
+        radsort::sort_by_key(&mut listed, Step::order_key);
+    } else {
+        listed.clear();
+    }
+    let mut listed = listed.into_iter().peekable();
     let mut follows = std::collections::BinaryHeap::new();
     let (mut taken, mut settled) = (Vec::new(), 0);
     // The frame as it will run (creatures going down still cost their level): a search is
     // paid for at once and never given back, so it must fit beside that too.
     let mut running_us: f32 = candidates.iter().map(|c| c.frame_cost_us(c.floor)).sum();
     loop {
-        let step = match (firsts.peek(), follows.peek()) {
-            (Some(first), Some(follow)) if follow > first => follows.pop(),
-            (Some(_), _) => firsts.next(),
-            (None, _) => follows.pop(),
+        let (step, followed) = match (listed.peek(), follows.peek()) {
+            (Some(first), Some(follow)) if follow > first => (follows.pop(), true),
+            (Some(_), _) => (listed.next(), false),
+            (None, _) => (follows.pop(), true),
         };
         let Some(step) = step else { break };
         if spent + cheapest_us > budget_us {
             break;
+        }
+        // A step from a level the creature did not reach, or a bound since settled.
+        if levels[step.creature] != step.from || (step.bound && candidates[step.creature].settled) {
+            continue;
         }
         let c = &mut candidates[step.creature];
         if step.bound {
@@ -239,7 +272,10 @@ pub fn allocate(
             spent += step.extra_us;
             running_us += c.frame_cost_us(step.to) - c.frame_cost_us(step.from);
             taken.push(step);
-            follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us));
+            // A listed step's successor is listed too.
+            if followed {
+                follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us));
+            }
         }
     }
     let searched_us = settled as f32 * settle_us;
@@ -274,26 +310,14 @@ pub fn allocate(
     }
 }
 
-/// What every creature costs at its floor, and the least any step up can cost: once the room
-/// left is below that, the choice is over.
-fn floors_and_cheapest_step_us(candidates: &[Candidate]) -> (f32, f32) {
-    let floors_us = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
-    let cheapest_us = candidates
-        .iter()
-        .flat_map(|c| {
-            c.levels
-                .iter()
-                .filter(|&&l| l >= c.floor)
-                .map(|&l| c.cheapest_step_us(l))
-        })
-        .fold(f32::INFINITY, f32::min);
-    (floors_us, cheapest_us)
-}
-
 /// Whether any creature's cheapest step up fits in `budget_us` beside every creature at its
 /// floor: if not, [`allocate`] gives every creature its floor.
 fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
-    let (floors_us, cheapest_us) = floors_and_cheapest_step_us(candidates);
+    let floors_us: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
+    let cheapest_us = candidates
+        .iter()
+        .map(Candidate::cheapest_step_above_floor_us)
+        .fold(f32::INFINITY, f32::min);
     floors_us + cheapest_us <= budget_us
 }
 
@@ -655,23 +679,16 @@ fn decide(
             searched: Vec::new(),
         };
     }
-    // In the order of the serials (ties go to the lower); each creature's bounds are its own,
-    // worked out across the cores.
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    order.sort_unstable_by_key(|&i| rows[i].1.serial);
-    let mut by_serial: Vec<Candidate> = order.iter().map(|&i| candidates[i].clone()).collect();
+    // Each creature's bounds are its own, worked out across the cores.
     let mut bounds = vec![Bounds::default(); rows.len()];
     let n = chunk_len(config.scenario.creature_count(), rows.len());
     run_chunks(
-        order
-            .chunks(n)
-            .zip(by_serial.chunks_mut(n))
+        rows.chunks(n)
+            .zip(candidates.chunks_mut(n))
             .zip(bounds.chunks_mut(n))
-            .map(|((order, candidates), bounds)| {
-                let rows = &rows;
+            .map(|((rows, candidates), bounds)| {
                 move || {
-                    for ((&i, candidate), bound) in order.iter().zip(candidates).zip(bounds) {
-                        let (entity, c, _, s, choice) = rows[i];
+                    for ((&(entity, c, _, s, choice), candidate), bound) in rows.iter().zip(candidates).zip(bounds) {
                         *bound = scene.bounds(entity, s, &kinds[c.kind]);
                         // A search within `contact_recheck_s` stands; without one, any
                         // contact with another creature could be now.
@@ -685,20 +702,14 @@ fn decide(
     // Only a creature that could still buy a level is searched for contacts with the others.
     let search_us = config.costs.contact_search_us;
     let mut searched = Vec::new();
-    let mut allocation = allocate(&mut by_serial, room_us, hysteresis, least_per_us, search_us, |i| {
-        let (_, c, _, s, _) = rows[order[i]];
+    let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, search_us, |i| {
+        let (_, c, _, s, _) = rows[i];
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
-        searched.push((order[i], urgency));
+        searched.push((i, urgency));
         bounds[i].rigid(rules, urgency)
     });
     searched.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
-    // Back in the query's order.
-    let mut levels = vec![Lod::PointMass; rows.len()];
-    for (&i, &level) in order.iter().zip(&allocation.levels) {
-        levels[i] = level;
-    }
-    allocation.levels = levels;
     Decision {
         entities,
         allocation,
