@@ -4,7 +4,7 @@
 //! corrected after a slow one.
 
 use super::{Validate, Validator};
-use crate::contract::Lod;
+use crate::contract::{Lod, PARALLEL_MIN_CREATURES};
 use serde::{Deserialize, Serialize};
 
 /// Predicted costs per kind and level.
@@ -30,6 +30,22 @@ pub struct CostModel {
     /// still buy a level are). A file without it predicts 0.
     #[serde(default)]
     pub contact_search_us: f32,
+    /// What the point-mass and hybrid levels cost per creature in a crowd, where they are
+    /// stepped across the cores, as shares of the figures above (measured on one thread). A
+    /// file without it predicts a crowd at those figures.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crowd_shares: Option<CrowdShares>,
+}
+
+/// The cheap levels' cost per creature in a crowd of [`PARALLEL_MIN_CREATURES`] or more, as
+/// shares of their cost on one thread; each 0.01 to 10.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CrowdShares {
+    /// Of the point-mass level's cost.
+    pub point_mass: f32,
+    /// Of the hybrid level's cost.
+    pub hybrid: f32,
 }
 
 /// A kind's costs, by name.
@@ -91,6 +107,17 @@ impl CostModel {
         self.fixed_us_per_frame + self.decision_us_per_creature * creatures as f32
     }
 
+    /// The costs of the kind named `kind` in a world of `creatures`: in a crowd, the cheap
+    /// levels at their crowd shares.
+    pub fn in_crowd(&self, kind: &str, creatures: u32) -> LevelCosts {
+        let mut costs = *self.of(kind);
+        if let Some(shares) = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES) {
+            costs.point_mass_us_per_frame *= shares.point_mass;
+            costs.hybrid_us_per_frame *= shares.hybrid;
+        }
+        costs
+    }
+
     /// The costs of the kind named `kind`.
     pub fn of(&self, kind: &str) -> &LevelCosts {
         self.kinds
@@ -120,6 +147,12 @@ impl Validate for CostModel {
             LevelCosts::MOST_US,
         );
         v.within("contact_search_us", self.contact_search_us, 0.0, LevelCosts::MOST_US);
+        if let Some(shares) = self.crowd_shares {
+            v.nested("crowd_shares", |v| {
+                v.within("point_mass", shares.point_mass, 0.01, 10.0);
+                v.within("hybrid", shares.hybrid, 0.01, 10.0);
+            });
+        }
     }
 }
 
@@ -140,5 +173,28 @@ mod tests {
         let negative = format!("(kinds: [], other_kinds: {COSTS}, fixed_us_per_frame: -3)");
         let err = parse_ron::<CostModel>(negative.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`fixed_us_per_frame`"), "{err}");
+    }
+
+    #[test]
+    fn in_a_crowd_the_cheap_levels_cost_their_shares_and_a_share_out_of_range_is_refused() {
+        let text = format!("(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((point_mass: 0.5, hybrid: 0.25)))");
+        let model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
+        let (few, crowd) = (
+            model.in_crowd("hopper", PARALLEL_MIN_CREATURES - 1),
+            model.in_crowd("hopper", PARALLEL_MIN_CREATURES),
+        );
+        assert_eq!((few.point_mass_us_per_frame, few.hybrid_us_per_frame), (1.0, 2.0));
+        assert_eq!((crowd.point_mass_us_per_frame, crowd.hybrid_us_per_frame), (0.5, 0.5));
+        assert_eq!(crowd.rigid_us_per_frame, few.rigid_us_per_frame);
+        // Without shares a crowd costs what one thread measured.
+        let plain: CostModel = parse_ron(
+            format!("(kinds: [], other_kinds: {COSTS})").as_bytes(),
+            Path::new("costs.ron"),
+        )
+        .unwrap();
+        assert_eq!(plain.in_crowd("hopper", 1_000_000), *plain.of("hopper"));
+        let bad = text.replace("0.25", "0");
+        let err = parse_ron::<CostModel>(bad.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(err.to_string().contains("`crowd_shares.hybrid`"), "{err}");
     }
 }

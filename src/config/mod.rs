@@ -17,7 +17,7 @@ mod validate;
 
 pub use crate::contract::MAX_LEGS;
 pub use arena::{ArenaConfig, PuckConfig};
-pub use costs::{CostModel, KindCosts, LevelCosts};
+pub use costs::{CostModel, CrowdShares, KindCosts, LevelCosts};
 pub use creature::{
     BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, RaibertConfig, RigidConfig, RigidJoints, Stance,
     SteeringConfig,

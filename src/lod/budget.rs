@@ -644,7 +644,12 @@ fn decide(
     creatures: &Creatures,
     budget_us: f32,
 ) -> Decision {
-    let costs: Vec<LevelCosts> = config.kinds.iter().map(|k| *config.costs.of(&k.name)).collect();
+    let population = config.scenario.creature_count();
+    let costs: Vec<LevelCosts> = config
+        .kinds
+        .iter()
+        .map(|k| config.costs.in_crowd(&k.name, population))
+        .collect();
     let rows: Vec<_> = creatures.iter().collect();
     let mut candidates: Vec<Candidate> = rows
         .iter()
@@ -671,8 +676,18 @@ fn decide(
     // Where not one step up fits, every creature keeps its floor whatever the benefits: they
     // are not worked out, and the choice costs next to nothing (a crowd far over its budget).
     if !any_step_fits(&candidates, room_us) {
-        let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, 0.0, |_| 0.0);
-        allocation.predicted_us += config.costs.overhead_us(0);
+        // With no benefit, no step is taken: the floors, over the budget only if the frame
+        // without the choice's charge is.
+        let fixed_us = config.costs.overhead_us(0);
+        let mut allocation = allocate(
+            &mut candidates,
+            budget_us - fixed_us,
+            hysteresis,
+            least_per_us,
+            0.0,
+            |_| 0.0,
+        );
+        allocation.predicted_us += fixed_us;
         return Decision {
             entities,
             allocation,

@@ -28,6 +28,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         fixed_us_per_frame: 0.0,
         decision_us_per_creature: 0.0,
         contact_search_us: 0.0,
+        crowd_shares: None,
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config
@@ -216,14 +217,20 @@ fn the_fixed_cost_and_the_choice_come_off_the_budget_before_any_creature() {
     }
     assert!(rigid_seen <= 1, "{rigid_seen} rigid at once");
     assert_eq!(sim.summary(0.0).budget.unwrap().decisions_over_budget, 0);
-    // An overhead beyond the budget leaves every creature at its cheapest, and says so.
-    config.costs.fixed_us_per_frame = 550.0;
-    let mut sim = HeadlessSim::new(config);
-    sim.run_for(3.0);
-    let summary = sim.summary(0.0);
-    assert_eq!(summary.levels[Lod::PointMass], 30, "{:?}", summary.levels);
-    let budget = summary.budget.unwrap();
-    assert_eq!(budget.decisions_over_budget, budget.decisions);
+    // An overhead that leaves no room for a step leaves every creature at its cheapest; the
+    // choice is then not made, so it is over budget only where the rest is (580 + 30 us, not
+    // 550 + 30).
+    for (fixed_us, over) in [(550.0, false), (580.0, true)] {
+        config.costs.fixed_us_per_frame = fixed_us;
+        let mut sim = HeadlessSim::new(config.clone());
+        sim.run_for(3.0);
+        let summary = sim.summary(0.0);
+        assert_eq!(summary.levels[Lod::PointMass], 30, "{:?}", summary.levels);
+        let budget = summary.budget.unwrap();
+        let expected = if over { budget.decisions } else { 0 };
+        assert_eq!(budget.decisions_over_budget, expected, "{fixed_us} us: {budget:?}");
+        assert!(budget.searched_per_decision == 0.0, "{budget:?}");
+    }
 }
 
 /// Runs `seconds` of a budget scene, telling the policy after each frame that it took

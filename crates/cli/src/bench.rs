@@ -100,6 +100,12 @@ impl BenchArgs {
                 "  a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
                 model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
             );
+            if let Some(shares) = model.crowd_shares {
+                println!(
+                    "  in a crowd (across the cores): point mass x {:.2}, hybrid x {:.2}",
+                    shares.point_mass, shares.hybrid
+                );
+            }
         }
         Ok(())
     }

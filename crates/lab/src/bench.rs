@@ -10,7 +10,7 @@ pub use crate::scene::scaled;
 use serde::Serialize;
 use std::time::Instant;
 
-use simlod::config::{CostModel, KindCosts, LevelCosts, SimConfig};
+use simlod::config::{CostModel, CrowdShares, KindCosts, LevelCosts, SimConfig};
 use simlod::creature::KindTable;
 use simlod::headless::HeadlessSim;
 use simlod::lod::{LevelPolicy, Lod};
@@ -255,7 +255,8 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 /// the fixed cost, divided by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so
 /// one thread, as in a game), and the switch into the rigid level (see `switch_cost_us`). A
 /// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
-/// policy's own choice per creature, in the scenario's mix scaled up.
+/// policy's own choice (see `choice_cost_us`), and the cheap levels' cost per creature in a
+/// crowd stepped across the cores, as shares of their cost on one thread.
 pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
     let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
@@ -317,9 +318,22 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
         fixed_us_per_frame: fixed_us as f32,
         decision_us_per_creature: 0.0,
         contact_search_us: 0.0,
+        crowd_shares: None,
     };
     let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, warmup, frames);
     (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
+    // The cheap levels in a crowd, stepped across the cores: the scenario's mix at a crowd
+    // size against the same at the count above, per creature.
+    let crowd_count = 8 * simlod::PARALLEL_MIN_CREATURES;
+    let share = |policy: LevelPolicy| {
+        let per_creature =
+            |count: u32| (frame_us(config, count, policy, runs, frames) - fixed_us).max(0.0) / f64::from(count);
+        (per_creature(crowd_count) / per_creature(cheap_count).max(1e-6)).clamp(0.01, 10.0) as f32
+    };
+    model.crowd_shares = Some(CrowdShares {
+        point_mass: share(LevelPolicy::AllPointMass),
+        hybrid: share(LevelPolicy::AllHybrid),
+    });
     model
 }
 
