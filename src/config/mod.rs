@@ -64,6 +64,15 @@ pub struct MeasuredAnew<'a> {
 }
 
 impl SimConfig {
+    /// What each of its kinds costs (in the kinds' order) in a world of its scenario's size.
+    pub fn costs_by_kind(&self) -> Vec<LevelCosts> {
+        let population = self.scenario.creature_count();
+        self.kinds
+            .iter()
+            .map(|k| self.costs.in_crowd(&k.name, population))
+            .collect()
+    }
+
     /// Loads a scenario file and the arena and creature files it names, resolved against
     /// `assets_root` (`arena` is a path under it; a creature kind `k` is
     /// `creatures/k.ron`). Every problem is reported with the file it is in; a file that

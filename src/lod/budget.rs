@@ -644,12 +644,7 @@ fn decide(
     creatures: &Creatures,
     budget_us: f32,
 ) -> Decision {
-    let population = config.scenario.creature_count();
-    let costs: Vec<LevelCosts> = config
-        .kinds
-        .iter()
-        .map(|k| config.costs.in_crowd(&k.name, population))
-        .collect();
+    let costs = config.costs_by_kind();
     let rows: Vec<_> = creatures.iter().collect();
     let mut candidates: Vec<Candidate> = rows
         .iter()

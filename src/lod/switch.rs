@@ -178,12 +178,7 @@ fn count_levels(
     if !clock.is_decision_tick() {
         return;
     }
-    let population = config.scenario.creature_count();
-    let costs: Vec<_> = config
-        .kinds
-        .iter()
-        .map(|k| config.costs.in_crowd(&k.name, population))
-        .collect();
+    let costs = config.costs_by_kind();
     let mut counts: Counts<Lod, u64> = Counts::default();
     let mut frame_us = f64::from(config.costs.fixed_us_per_frame);
     for (&lod, c) in &levels {
