@@ -33,6 +33,29 @@ pub struct GameConfig {
     pub creature_look: CreatureLook,
     /// How `--record` writes its animated picture.
     pub recording: RecordingConfig,
+    /// The budget policy in the game. A file without it leaves the rules as they are.
+    #[serde(default)]
+    pub frame_budget: FrameBudgetInGame,
+}
+
+/// The budget policy in the game, where the frame rate matters more than a reproducible run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameBudgetInGame {
+    /// Where the rules leave the adaptive mode off (`budget.adaptive_frames` at 0), the game
+    /// corrects the cost model by its measured frames, smoothed over this many; 0 leaves it
+    /// off. 0 to 10,000 frames.
+    pub adaptive_frames: f32,
+}
+
+impl FrameBudgetInGame {
+    /// The rules the game runs: `rules` as the files say them, with the adaptive mode on
+    /// where they leave it off.
+    pub fn apply(&self, rules: &mut super::LevelRules) {
+        if rules.budget.adaptive_frames == 0.0 {
+            rules.budget.adaptive_frames = self.adaptive_frames;
+        }
+    }
 }
 
 /// The player's view (paper figure 6, bottom): behind the player on the line from the puck,
@@ -247,6 +270,9 @@ impl Validate for GameConfig {
             v.range("smoothing_s", h.smoothing_s, 0.01, 60.0);
             v.within("radius_step_m", h.radius_step_m, 0.1, 10.0);
             v.range("budget_step_ms", h.budget_step_ms, 0.01, 100.0);
+        });
+        v.nested("frame_budget", |v| {
+            v.within("adaptive_frames", self.frame_budget.adaptive_frames, 0.0, 10_000.0);
         });
         let k = &self.creature_look;
         v.nested("creature_look", |v| {

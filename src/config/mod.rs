@@ -23,7 +23,8 @@ pub use creature::{
     SteeringConfig,
 };
 pub use game::{
-    CameraConfig, CreatureLook, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig, SceneColours, Srgb,
+    CameraConfig, CreatureLook, FrameBudgetInGame, GameConfig, HudConfig, InsetConfig, LightingConfig, RecordingConfig,
+    SceneColours, Srgb,
 };
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use overrides::Overrides;

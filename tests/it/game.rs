@@ -418,3 +418,64 @@ fn under_the_camera_rule_no_creature_whose_body_is_in_the_rendered_view_is_a_poi
         "{seen} seen, {unseen_point_masses} point masses out of view"
     );
 }
+
+#[test]
+fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit_of_either_applies() {
+    let root = copy_assets("game_adaptive_budget");
+    let mut app = watching_app(&root);
+    let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
+    assert_eq!(looks.frame_budget.adaptive_frames, 30.0, "as shipped");
+    app.insert_resource(GameSettings(looks.clone()));
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let adaptive = |app: &mut App| {
+        [
+            app.world().resource::<SimConfig>(),
+            &app.world().resource::<BaseConfig>().0,
+        ]
+        .map(|c| c.rules.budget.adaptive_frames)
+    };
+    // An edit of the rules (which leave the adaptive mode off) runs with the game's.
+    let rules_file = root.join("rules/levels.ron");
+    let rules = std::fs::read_to_string(&rules_file).unwrap();
+    assert!(rules.contains("adaptive_frames: 0.0,"));
+    std::fs::write(&rules_file, rules.replacen("min_dwell_s: 0.5", "min_dwell_s: 0.4", 1)).unwrap();
+    update_until(&mut app, "the rules edit", |app| {
+        app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
+    });
+    assert_eq!(adaptive(&mut app), [30.0; 2]);
+    // The game's setting edited: at once, running and for the next rounds.
+    let game_file = root.join("game.ron");
+    let text = std::fs::read_to_string(&game_file).unwrap();
+    std::fs::write(
+        &game_file,
+        text.replacen("adaptive_frames: 30.0", "adaptive_frames: 0.0", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the game file's edit", |app| {
+        app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 0.0
+    });
+    assert_eq!(adaptive(&mut app), [0.0; 2]);
+    // Rules that set their own adaptive mode keep it whatever the game says.
+    let rules = std::fs::read_to_string(&rules_file).unwrap();
+    std::fs::write(
+        &rules_file,
+        rules.replacen("adaptive_frames: 0.0,", "adaptive_frames: 12.0,", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the rules' own adaptive mode", |app| {
+        app.world().resource::<SimConfig>().rules.budget.adaptive_frames == 12.0
+    });
+    let text = std::fs::read_to_string(&game_file).unwrap();
+    std::fs::write(
+        &game_file,
+        text.replacen("adaptive_frames: 0.0", "adaptive_frames: 45.0", 1),
+    )
+    .unwrap();
+    update_until(&mut app, "the second game file's edit", |app| {
+        app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
+    });
+    assert_eq!(adaptive(&mut app), [12.0; 2]);
+}

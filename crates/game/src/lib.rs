@@ -69,6 +69,7 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
     let file_rules = config.rules.clone();
     options.overrides.apply(&mut config);
     let looks: GameConfig = load_file(&options.assets.join(GAME_FILE))?;
+    looks.frame_budget.apply(&mut config.rules);
     if let Some(plan) = &options.capture
         && plan.kind == Capture::Recording
         && plan.frames < looks.recording.every_nth_frame

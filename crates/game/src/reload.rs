@@ -220,6 +220,7 @@ fn apply_changes(
     mut base: ResMut<BaseConfig>,
     mut live: ResMut<SimConfig>,
     mut rounds: MessageWriter<NewRound>,
+    settings: Option<Res<GameSettings>>,
 ) {
     if !watched.changed {
         return;
@@ -233,6 +234,9 @@ fn apply_changes(
             let rules_edited = watched.file_rules.as_ref() != Some(&config.rules);
             if rules_edited {
                 watched.file_rules = Some(config.rules.clone());
+                if let Some(settings) = &settings {
+                    settings.0.frame_budget.apply(&mut config.rules);
+                }
                 live.rules = config.rules.clone();
             } else {
                 config.rules = base.rules.clone();
@@ -253,12 +257,27 @@ fn apply_changes(
     watched.changed = false;
 }
 
-fn apply_looks(watched: Res<Watched>, looks: Res<Assets<GameConfig>>, mut settings: ResMut<GameSettings>) {
-    if let Some(new) = looks.get(&watched.game)
-        && *new != settings.0
+/// A good edit of `game.ron` applies at once: the looks, and the game's adaptive mode of the
+/// budget where the rules leave it off.
+fn apply_looks(
+    watched: Res<Watched>,
+    looks: Res<Assets<GameConfig>>,
+    mut settings: ResMut<GameSettings>,
+    mut base: ResMut<BaseConfig>,
+    mut live: ResMut<SimConfig>,
+) {
+    let Some(new) = looks.get(&watched.game).filter(|new| **new != settings.0) else {
+        return;
+    };
+    if new.frame_budget != settings.0.frame_budget
+        && let Some(files) = &watched.file_rules
     {
-        settings.0 = new.clone();
+        let mut rules = files.clone();
+        new.frame_budget.apply(&mut rules);
+        base.rules.budget.adaptive_frames = rules.budget.adaptive_frames;
+        live.rules.budget.adaptive_frames = rules.budget.adaptive_frames;
     }
+    settings.0 = new.clone();
 }
 
 /// Hot reload: watches the asset files from startup, notes each file's problems for the HUD,
