@@ -105,6 +105,13 @@ fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) 
     app
 }
 
+/// Edits the file at `path` as a modder would: its first `from` becomes `to`.
+fn edit(path: &Path, from: &str, to: &str) {
+    let text = std::fs::read_to_string(path).unwrap();
+    assert!(text.contains(from), "{} has no {from:?}", path.display());
+    std::fs::write(path, text.replacen(from, to, 1)).unwrap();
+}
+
 /// Updates until `done` holds (file events take a moment to arrive).
 fn update_until(app: &mut App, what: &str, done: impl Fn(&mut App) -> bool) {
     let start = Instant::now();
@@ -438,42 +445,29 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
         .map(|c| c.rules.budget.adaptive_frames)
     };
     // An edit of the rules (which leave the adaptive mode off) runs with the game's.
-    let rules_file = root.join("rules/levels.ron");
-    let rules = std::fs::read_to_string(&rules_file).unwrap();
-    assert!(rules.contains("adaptive_frames: 0.0,"));
-    std::fs::write(&rules_file, rules.replacen("min_dwell_s: 0.5", "min_dwell_s: 0.4", 1)).unwrap();
+    let (rules_file, game_file) = (root.join("rules/levels.ron"), root.join("game.ron"));
+    assert!(
+        std::fs::read_to_string(&rules_file)
+            .unwrap()
+            .contains("adaptive_frames: 0.0,")
+    );
+    edit(&rules_file, "min_dwell_s: 0.5", "min_dwell_s: 0.4");
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
     assert_eq!(adaptive(&mut app), [30.0; 2]);
     // The game's setting edited: at once, running and for the next rounds.
-    let game_file = root.join("game.ron");
-    let text = std::fs::read_to_string(&game_file).unwrap();
-    std::fs::write(
-        &game_file,
-        text.replacen("adaptive_frames: 30.0", "adaptive_frames: 0.0", 1),
-    )
-    .unwrap();
+    edit(&game_file, "adaptive_frames: 30.0", "adaptive_frames: 0.0");
     update_until(&mut app, "the game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 0.0
     });
     assert_eq!(adaptive(&mut app), [0.0; 2]);
     // Rules that set their own adaptive mode keep it whatever the game says.
-    let rules = std::fs::read_to_string(&rules_file).unwrap();
-    std::fs::write(
-        &rules_file,
-        rules.replacen("adaptive_frames: 0.0,", "adaptive_frames: 12.0,", 1),
-    )
-    .unwrap();
+    edit(&rules_file, "adaptive_frames: 0.0,", "adaptive_frames: 12.0,");
     update_until(&mut app, "the rules' own adaptive mode", |app| {
         app.world().resource::<SimConfig>().rules.budget.adaptive_frames == 12.0
     });
-    let text = std::fs::read_to_string(&game_file).unwrap();
-    std::fs::write(
-        &game_file,
-        text.replacen("adaptive_frames: 0.0", "adaptive_frames: 45.0", 1),
-    )
-    .unwrap();
+    edit(&game_file, "adaptive_frames: 0.0", "adaptive_frames: 45.0");
     update_until(&mut app, "the second game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
     });
