@@ -25,12 +25,12 @@ pub const PARALLEL_MIN_CREATURES: u32 = 2048;
 pub const DENSE: &str = "table components and archetype filters only: a dense query";
 
 /// How many of `len` items (a table's column) each thread takes in a loop over creatures: all
-/// of them below [`PARALLEL_MIN_CREATURES`].
+/// of them below [`PARALLEL_MIN_CREATURES`], or where there is no compute pool (outside an app).
 pub fn chunk_len(population: u32, len: usize) -> usize {
     let threads = if population < PARALLEL_MIN_CREATURES {
         1
     } else {
-        bevy::tasks::ComputeTaskPool::get().thread_num().max(1)
+        bevy::tasks::ComputeTaskPool::try_get().map_or(1, |pool| pool.thread_num().max(1))
     };
     len.div_ceil(threads).max(1)
 }

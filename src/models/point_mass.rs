@@ -323,6 +323,7 @@ fn step_point_masses(
     let stepper = PlanarStepper::new(&kinds, &clock);
     let in_frame = clock.tick_in_frame();
     let last_of_frame = in_frame + 1 == u64::from(clock.ticks_per_decision);
+    let mid_frame = in_frame > 0 && !last_of_frame;
     let step = |creature: &Creature,
                 lod: Lod,
                 desired: Vec2,
@@ -357,6 +358,24 @@ fn step_point_masses(
             .zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)));
         run_chunks(chunks.map(|((((c, l), d), ((s, g), p)), (f, seg))| {
             move || {
+                if mid_frame {
+                    // Only the creatures not behind move: found by a scan of their flags alone,
+                    // not a walk over every column (in a crowd nearly all are behind).
+                    let mut i = 0;
+                    while let Some(skip) = f[i..].iter().position(|f| !f.behind) {
+                        i += skip;
+                        step(
+                            &c[i],
+                            l[i],
+                            d[i].0,
+                            (&mut s[i], &mut g[i], &mut p[i]),
+                            &mut f[i],
+                            &mut seg[i],
+                        );
+                        i += 1;
+                    }
+                    return;
+                }
                 let rows = (c.iter().zip(l).zip(d))
                     .zip((s.iter_mut().zip(g)).zip(p.iter_mut()))
                     .zip(f.iter_mut().zip(seg));

@@ -6,7 +6,9 @@ use bevy::prelude::*;
 use crate::config::SimConfig;
 use crate::contract::PlanarState;
 use crate::contract::{SimClock, SimStage, SimStart, StartStage};
+use crate::contract::{chunk_len, run_chunks};
 use crate::kind::{Creature, KindTable};
+use bevy::utils::Parallel;
 
 /// The court's inside, on the ground plane.
 #[derive(Resource, Clone, Copy, Debug)]
@@ -97,19 +99,37 @@ impl NeighbourGrid {
     pub fn rebuild(&mut self, items: impl Iterator<Item = Neighbour>) {
         self.scratch.clear();
         self.scratch.extend(items);
-        self.keys.clear();
-        self.block_start.fill(0);
+        let len = self.scratch.len();
+        // Each item's block and cell, and the fastest and widest, across the cores.
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.resize(len, (0, 0));
+        let n = chunk_len(len as u32, len);
+        let mut widest = Parallel::<(f32, f32)>::default();
+        let grid = &*self;
+        run_chunks(self.scratch.chunks(n).zip(keys.chunks_mut(n)).map(|(items, keys)| {
+            let widest = &widest;
+            move || {
+                let (mut fastest, mut wide) = (0.0f32, 0.0f32);
+                for (n, key) in items.iter().zip(keys) {
+                    fastest = fastest.max(n.velocity.length());
+                    wide = wide.max(n.radius);
+                    let (x, y) = grid.cell_xy(n.position);
+                    *key = (y * grid.block_cols + x / BLOCK_CELLS, y * grid.cols + x);
+                }
+                let mut w = widest.borrow_local_mut();
+                *w = (w.0.max(fastest), w.1.max(wide));
+            }
+        }));
+        self.keys = keys;
+        (self.fastest_m_per_s, self.widest_radius_m) = widest
+            .iter_mut()
+            .fold((0.0f32, 0.0f32), |(f, w), fw| (f.max(fw.0), w.max(fw.1)));
         // Block b's count goes to b + 2, so that after the sums `block_start[b + 1]` is where b
         // starts; the scatter moves it on to where b ends, which is where b + 1 starts (no copy
         // of the starts as the scatter's cursors).
+        self.block_start.fill(0);
         let last = self.block_start.len() - 2;
-        (self.fastest_m_per_s, self.widest_radius_m) = (0.0, 0.0);
-        for n in &self.scratch {
-            self.fastest_m_per_s = self.fastest_m_per_s.max(n.velocity.length());
-            self.widest_radius_m = self.widest_radius_m.max(n.radius);
-            let (x, y) = self.cell_xy(n.position);
-            let b = y * self.block_cols + x / BLOCK_CELLS;
-            self.keys.push((b, y * self.cols + x));
+        for &(b, _) in &self.keys {
             if (b as usize) < last {
                 self.block_start[b as usize + 2] += 1;
             }
@@ -120,11 +140,9 @@ impl NeighbourGrid {
             sum += *start;
             *start = sum;
         }
-        // Scatter in input order within each block: deterministic.
-        let len = self.scratch.len();
-        self.entries.clear();
-        self.entries.resize(len, self.scratch.first().copied().unwrap_or(EMPTY));
-        self.entry_cell.clear();
+        // Scatter in input order within each block: deterministic. Every slot is written, so
+        // the arrays are only resized (not cleared and filled first: a pass of its own).
+        self.entries.resize(len, EMPTY);
         self.entry_cell.resize(len, 0);
         for (n, &(b, c)) in self.scratch.iter().zip(&self.keys) {
             let slot = &mut self.block_start[b as usize + 1];
@@ -132,17 +150,22 @@ impl NeighbourGrid {
             self.entry_cell[*slot as usize] = c;
             *slot += 1;
         }
-        // Then by cell within each block, stably (a block holds a creature or two: insertion).
+        // Then by cell within each block, stably (a block holds a creature or two: insertion,
+        // shifted by hand rather than by `rotate_right`'s call to `memmove`).
         for i in 1..len {
             let c = self.entry_cell[i];
+            if self.entry_cell[i - 1] <= c {
+                continue;
+            }
+            let n = self.entries[i];
             let mut j = i;
             while j > 0 && self.entry_cell[j - 1] > c {
+                self.entries[j] = self.entries[j - 1];
+                self.entry_cell[j] = self.entry_cell[j - 1];
                 j -= 1;
             }
-            if j < i {
-                self.entries[j..=i].rotate_right(1);
-                self.entry_cell[j..=i].rotate_right(1);
-            }
+            self.entries[j] = n;
+            self.entry_cell[j] = c;
         }
     }
 
