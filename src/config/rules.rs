@@ -112,6 +112,12 @@ pub struct BudgetRules {
     /// runs are not reproducible. 0 to 10,000 frames.
     #[serde(default)]
     pub adaptive_frames: f32,
+    /// The adaptive mode's emergency tier (after Unreal's Animation Budget Allocator): a frame
+    /// measured over this many times the budget sets the correction at once to what that frame
+    /// measured, rather than over `adaptive_frames`, so the next decision already spends less.
+    /// 0 (the default) has none; else 1 to 100.
+    #[serde(default)]
+    pub emergency_over: f32,
 }
 
 impl Validate for LevelRules {
@@ -157,6 +163,13 @@ impl Validate for LevelRules {
             v.within("hysteresis", b.hysteresis, 0.0, 10.0);
             v.within("least_benefit_per_ms", b.least_benefit_per_ms, 0.0, 1e6);
             v.within("adaptive_frames", b.adaptive_frames, 0.0, 10_000.0);
+            let e = b.emergency_over;
+            if !(e == 0.0 || (1.0..=100.0).contains(&e)) {
+                v.fail(
+                    "emergency_over",
+                    format!("must be 0 (none) or between 1 and 100, got {e}"),
+                );
+            }
         });
         let (a, b) = self.flight_window;
         v.range("flight_window.0", a, 0.0, 1.0);

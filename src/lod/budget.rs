@@ -323,13 +323,19 @@ fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
 
 /// The adaptive mode's correction of the cost model after one more measured frame: the
 /// measured over the predicted time, smoothed over about `frames` frames. A ratio beyond 10
-/// either way (a stalled frame) counts as 10.
-pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32) -> f32 {
+/// either way (a stalled frame) counts as 10. A frame measured over `emergency_us` (the
+/// emergency tier) sets the correction at once to its own ratio, where that is higher.
+pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32, emergency_us: f32) -> f32 {
     if model_us <= 0.0 || !measured_us.is_finite() {
         return correction;
     }
     let ratio = (measured_us / model_us).clamp(0.1, 10.0);
-    correction + (ratio - correction) / frames.max(1.0)
+    let smoothed = correction + (ratio - correction) / frames.max(1.0);
+    if measured_us > emergency_us {
+        smoothed.max(ratio)
+    } else {
+        smoothed
+    }
 }
 
 /// What the budget policy predicted, decision by decision (the summary and the HUD read it).
@@ -782,11 +788,22 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     if !inputs.clock.is_decision_tick() {
         return;
     }
-    let frames = inputs.config.rules.budget.adaptive_frames;
-    if frames > 0.0
+    let rules = &inputs.config.rules.budget;
+    if rules.adaptive_frames > 0.0
         && let Some(measured_us) = tally.measured_us
     {
-        tally.correction = corrected(tally.correction, tally.model_us, measured_us, frames);
+        let emergency_us = if rules.emergency_over > 0.0 {
+            rules.emergency_over * rules.frame_budget_ms * 1e3
+        } else {
+            f32::INFINITY
+        };
+        tally.correction = corrected(
+            tally.correction,
+            tally.model_us,
+            measured_us,
+            rules.adaptive_frames,
+            emergency_us,
+        );
     }
     let decision = inputs.decide(&creatures, tally.correction);
     tally.record(&decision.allocation);
@@ -1152,16 +1169,28 @@ mod tests {
     #[test]
     fn the_adaptive_correction_moves_toward_measured_over_predicted_and_ignores_a_stall() {
         // Frames measured at twice the prediction: over about 10 frames the correction nears 2.
+        let none = f32::INFINITY;
         let mut c = 1.0;
         for _ in 0..50 {
-            c = corrected(c, 1000.0, 2000.0, 10.0);
+            c = corrected(c, 1000.0, 2000.0, 10.0, none);
         }
         assert!((c - 2.0).abs() < 0.01, "{c}");
         // One frame stalled a thousand times over counts as ten times, a tenth of it.
-        let stalled = corrected(2.0, 1000.0, 1e9, 10.0);
+        let stalled = corrected(2.0, 1000.0, 1e9, 10.0, none);
         assert!((stalled - 2.8).abs() < 1e-5, "{stalled}");
         // Nothing predicted yet: nothing to correct.
-        assert_eq!(corrected(1.5, 0.0, 2000.0, 10.0), 1.5);
+        assert_eq!(corrected(1.5, 0.0, 2000.0, 10.0, none), 1.5);
+    }
+
+    #[test]
+    fn a_frame_over_the_emergency_line_corrects_at_once_and_one_under_it_is_smoothed() {
+        // Predicted 1 ms, measured 3 ms, with the emergency line at 1.5 ms: at once.
+        assert_eq!(corrected(1.0, 1000.0, 3000.0, 30.0, 1500.0), 3.0);
+        // Measured 1.4 ms, under the line: a thirtieth of the way.
+        let smoothed = corrected(1.0, 1000.0, 1400.0, 30.0, 1500.0);
+        assert!((smoothed - (1.0 + 0.4 / 30.0)).abs() < 1e-6, "{smoothed}");
+        // An emergency never lowers a correction already above its frame's ratio.
+        assert_eq!(corrected(4.0, 1000.0, 3000.0, 30.0, 1500.0), 4.0 - 1.0 / 30.0);
     }
 
     #[test]

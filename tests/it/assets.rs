@@ -164,6 +164,21 @@ fn solver_iterations_default_to_eight_and_out_of_range_are_refused() {
 }
 
 #[test]
+fn an_emergency_line_under_the_budget_is_refused() {
+    let err = load_error(
+        "emergency_over",
+        "rules/levels.ron",
+        &edited("rules/levels.ron", "emergency_over: 1.5", "emergency_over: 0.5"),
+    );
+    assert_names(
+        &err,
+        "rules/levels.ron",
+        "budget.emergency_over",
+        "must be 0 (none) or between 1 and 100, got 0.5",
+    );
+}
+
+#[test]
 fn a_nan_is_refused() {
     let err = load_error(
         "nan",

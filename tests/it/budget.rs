@@ -275,6 +275,51 @@ fn the_adaptive_mode_spends_less_where_frames_measure_dearer_than_the_cost_model
 }
 
 #[test]
+fn in_the_adaptive_mode_a_frame_far_over_the_budget_cuts_the_next_decision_at_once() {
+    let budget_ms = 0.6;
+    let mut config = budget_scene(30, budget_ms);
+    config.rules.budget.adaptive_frames = 30.0;
+    // No dwell: each decision may take back any level at once.
+    config.rules.min_dwell_s = 0.0;
+    let wanted_rigid = |sim: &mut HeadlessSim| {
+        let world = sim.app.world_mut();
+        let mut choices = world.query::<&LevelChoice>();
+        choices.iter(world).filter(|c| c.wanted == Lod::Rigid).count()
+    };
+    // Frames measure as predicted for 2 s, then one three times its prediction: the creatures
+    // wanted rigid before the spike, and the tally and creatures wanted rigid after the
+    // decision that follows it.
+    let spike = |emergency_over: f32| {
+        let mut config = config.clone();
+        config.rules.budget.emergency_over = emergency_over;
+        let mut sim = with_frames_measured(config, 2.0, |t| t.model_us);
+        let before = wanted_rigid(&mut sim);
+        let model_us = sim.app.world().resource::<BudgetTally>().model_us;
+        assert!(
+            3.0 * model_us > 1.5 * budget_ms * 1e3,
+            "the spike is over the line: {model_us} us"
+        );
+        sim.app.world_mut().resource_mut::<BudgetTally>().measured_us = Some(3.0 * model_us);
+        sim.advance_frame();
+        let tally = sim.app.world().resource::<BudgetTally>().clone();
+        (before, tally, wanted_rigid(&mut sim))
+    };
+    // With the emergency tier, the next decision spends as if every frame cost three times the
+    // model: it wants fewer creatures rigid at once.
+    let (before, at_once, rigid_at_once) = spike(1.5);
+    assert!((at_once.correction - 3.0).abs() < 0.05, "{at_once:?}");
+    assert!(rigid_at_once < before, "rigid wanted: {before}, then {rigid_at_once}");
+    // Without it, the spike moves the correction a thirtieth of the way, and the next decision
+    // keeps more of them.
+    let (_, smoothed, rigid_smoothed) = spike(0.0);
+    assert!(smoothed.correction < 1.1, "{smoothed:?}");
+    assert!(
+        rigid_smoothed > rigid_at_once,
+        "rigid wanted: {rigid_smoothed} smoothed, {rigid_at_once} at once"
+    );
+}
+
+#[test]
 fn with_the_adaptive_mode_off_measured_frame_times_do_not_change_the_run() {
     let config = budget_scene(30, 0.5);
     let mut slow = with_frames_measured(config.clone(), 5.0, |_| 1e6);
