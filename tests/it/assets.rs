@@ -168,7 +168,7 @@ fn an_emergency_line_under_the_budget_is_refused() {
     let err = load_error(
         "emergency_over",
         "rules/levels.ron",
-        &edited("rules/levels.ron", "emergency_over: 1.5", "emergency_over: 0.5"),
+        &edited("rules/levels.ron", "emergency_over: 0.0", "emergency_over: 0.5"),
     );
     assert_names(
         &err,
