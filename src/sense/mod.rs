@@ -150,23 +150,33 @@ impl NeighbourGrid {
             self.entry_cell[*slot as usize] = c;
             *slot += 1;
         }
-        // Then by cell within each block, stably (a block holds a creature or two: insertion,
-        // shifted by hand rather than by `rotate_right`'s call to `memmove`).
-        for i in 1..len {
-            let c = self.entry_cell[i];
-            if self.entry_cell[i - 1] <= c {
-                continue;
+        // Then by cell within each block, stably, in parts cut between blocks across the cores
+        // (nothing moves across a block's edge).
+        let block_of = |c: u32| (c / self.cols) * self.block_cols + (c % self.cols) / BLOCK_CELLS;
+        let n = chunk_len(len as u32, len);
+        // Where each part starts.
+        let mut cuts = vec![0];
+        let mut at = n;
+        while at < len {
+            while at < len && block_of(self.entry_cell[at]) == block_of(self.entry_cell[at - 1]) {
+                at += 1;
             }
-            let n = self.entries[i];
-            let mut j = i;
-            while j > 0 && self.entry_cell[j - 1] > c {
-                self.entries[j] = self.entries[j - 1];
-                self.entry_cell[j] = self.entry_cell[j - 1];
-                j -= 1;
-            }
-            self.entries[j] = n;
-            self.entry_cell[j] = c;
+            cuts.push(at);
+            at += n;
         }
+        let (mut entries, mut cells) = (&mut self.entries[..], &mut self.entry_cell[..]);
+        let mut parts = Vec::with_capacity(cuts.len());
+        for &start in cuts.iter().rev() {
+            let (rest, part) = entries.split_at_mut(start);
+            let (rest_cells, part_cells) = cells.split_at_mut(start);
+            parts.push((part, part_cells));
+            (entries, cells) = (rest, rest_cells);
+        }
+        run_chunks(
+            parts
+                .into_iter()
+                .map(|(entries, cells)| move || sort_by_cell(entries, cells)),
+        );
     }
 
     /// Creatures in the index.
@@ -239,6 +249,27 @@ impl NeighbourGrid {
         let mut best = radius;
         self.for_each_within(p, radius, |n| best = best.min(n.position.distance(p) - n.radius));
         best
+    }
+}
+
+/// Sorts `entries` by their `cells`, stably: by insertion, each out of order entry shifted by
+/// hand (they are few and near, a block holding a creature or two; a call to `rotate_right`, a
+/// `memmove`, each time was a third of a rebuild).
+fn sort_by_cell(entries: &mut [Neighbour], cells: &mut [u32]) {
+    for i in 1..cells.len() {
+        let c = cells[i];
+        if cells[i - 1] <= c {
+            continue;
+        }
+        let n = entries[i];
+        let mut j = i;
+        while j > 0 && cells[j - 1] > c {
+            entries[j] = entries[j - 1];
+            cells[j] = cells[j - 1];
+            j -= 1;
+        }
+        entries[j] = n;
+        cells[j] = c;
     }
 }
 
