@@ -5,8 +5,8 @@ use bevy::prelude::*;
 
 use crate::config::SimConfig;
 use crate::contract::PlanarState;
+use crate::contract::{DENSE, chunk_len, run_chunks};
 use crate::contract::{SimClock, SimStage, SimStart, StartStage};
-use crate::contract::{chunk_len, run_chunks};
 use crate::kind::{Creature, KindTable};
 use bevy::utils::Parallel;
 
@@ -97,30 +97,55 @@ impl NeighbourGrid {
 
     /// Replaces the contents with `items`.
     pub fn rebuild(&mut self, items: impl Iterator<Item = Neighbour>) {
-        self.scratch.clear();
-        self.scratch.extend(items);
-        let len = self.scratch.len();
-        // Each item's block and cell, and the fastest and widest, across the cores.
-        let mut keys = std::mem::take(&mut self.keys);
+        let items: Vec<Neighbour> = items.collect();
+        self.rebuild_parts(&[&items[..]], |part| part.len(), |part, i| part[i]);
+    }
+
+    /// Replaces the contents with the items of `parts` in order (say, a query's tables): the
+    /// `len_of(part)` items of each, the `i`-th made by `item(part, i)`. Made and keyed across
+    /// the cores, in one pass over each part.
+    pub fn rebuild_parts<P: Sync>(
+        &mut self,
+        parts: &[P],
+        len_of: impl Fn(&P) -> usize,
+        item: impl Fn(&P, usize) -> Neighbour + Sync,
+    ) {
+        let len = parts.iter().map(&len_of).sum();
+        let (mut scratch, mut keys) = (std::mem::take(&mut self.scratch), std::mem::take(&mut self.keys));
+        scratch.resize(len, EMPTY);
         keys.resize(len, (0, 0));
+        // Each item, its block and cell, and the fastest and widest.
         let n = chunk_len(len as u32, len);
         let mut widest = Parallel::<(f32, f32)>::default();
-        let grid = &*self;
-        run_chunks(self.scratch.chunks(n).zip(keys.chunks_mut(n)).map(|(items, keys)| {
-            let widest = &widest;
+        let mut jobs = Vec::new();
+        let (mut items, mut item_keys) = (&mut scratch[..], &mut keys[..]);
+        for part in parts {
+            let (here, rest) = std::mem::take(&mut items).split_at_mut(len_of(part));
+            let (here_keys, rest_keys) = std::mem::take(&mut item_keys).split_at_mut(here.len());
+            (items, item_keys) = (rest, rest_keys);
+            let starts = (0..here.len()).step_by(n);
+            jobs.extend(
+                starts
+                    .zip(here.chunks_mut(n).zip(here_keys.chunks_mut(n)))
+                    .map(|(start, c)| (part, start, c)),
+            );
+        }
+        let (grid, item, widest_now) = (&*self, &item, &widest);
+        run_chunks(jobs.into_iter().map(|(part, start, (items, keys))| {
             move || {
                 let (mut fastest, mut wide) = (0.0f32, 0.0f32);
-                for (n, key) in items.iter().zip(keys) {
+                for (i, (n, key)) in items.iter_mut().zip(keys).enumerate() {
+                    *n = item(part, start + i);
                     fastest = fastest.max(n.velocity.length());
                     wide = wide.max(n.radius);
                     let (x, y) = grid.cell_xy(n.position);
                     *key = (y * grid.block_cols + x / BLOCK_CELLS, y * grid.cols + x);
                 }
-                let mut w = widest.borrow_local_mut();
+                let mut w = widest_now.borrow_local_mut();
                 *w = (w.0.max(fastest), w.1.max(wide));
             }
         }));
-        self.keys = keys;
+        (self.scratch, self.keys) = (scratch, keys);
         (self.fastest_m_per_s, self.widest_radius_m) = widest
             .iter_mut()
             .fold((0.0f32, 0.0f32), |(f, w), fw| (f.max(fw.0), w.max(fw.1)));
@@ -291,16 +316,22 @@ pub(crate) fn index_creatures(
     if !clock.is_decision_tick() {
         return;
     }
-    grid.rebuild(creatures.iter().map(|(c, s)| {
-        let k = &kinds[c.kind];
-        Neighbour {
-            position: s.position,
-            velocity: s.velocity,
-            radius: k.radius_m,
-            mass: k.mass_kg,
-            serial: c.serial,
-        }
-    }));
+    // Table by table, in the query's order.
+    let tables: Vec<(&[Creature], &[PlanarState])> = creatures.contiguous_iter().expect(DENSE).collect();
+    grid.rebuild_parts(
+        &tables,
+        |(c, _)| c.len(),
+        |(c, s), i| {
+            let (c, s, k) = (&c[i], &s[i], &kinds[c[i].kind]);
+            Neighbour {
+                position: s.position,
+                velocity: s.velocity,
+                radius: k.radius_m,
+                mass: k.mass_kg,
+                serial: c.serial,
+            }
+        },
+    );
 }
 
 /// A grid sized for the court and the largest creature's reach.
