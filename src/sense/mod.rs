@@ -149,59 +149,74 @@ impl NeighbourGrid {
         (self.fastest_m_per_s, self.widest_radius_m) = widest
             .iter_mut()
             .fold((0.0f32, 0.0f32), |(f, w), fw| (f.max(fw.0), w.max(fw.1)));
+        // The blocks in a range a core, which counts, fills in input order and sorts by cell
+        // its own: each core reads every key and takes its range's.
+        let blocks = self.block_start.len() - 1;
+        let ranges = len.div_ceil(n).max(1);
+        let edge: Vec<usize> = (0..=ranges).map(|r| r * blocks / ranges).collect();
         // Block b's count goes to b + 2, so that after the sums `block_start[b + 1]` is where b
-        // starts; the scatter moves it on to where b ends, which is where b + 1 starts (no copy
-        // of the starts as the scatter's cursors).
-        self.block_start.fill(0);
-        let last = self.block_start.len() - 2;
-        for &(b, _) in &self.keys {
-            if (b as usize) < last {
-                self.block_start[b as usize + 2] += 1;
-            }
+        // starts; the fill moves it on to where b ends, which is where b + 1 starts (no copy of
+        // the starts as the fill's cursors). Range r counts into `edge[r] + 2..edge[r + 1] + 2`
+        // (the first from 0; the last block's count is never needed).
+        let keys = &self.keys;
+        let mut counts = Vec::with_capacity(ranges);
+        let (mut rest, mut base) = (&mut self.block_start[..], 0);
+        for r in 0..ranges {
+            let end = if r + 1 == ranges { blocks + 1 } else { edge[r + 1] + 2 };
+            let (mine, more) = std::mem::take(&mut rest).split_at_mut(end - base);
+            counts.push((base, mine));
+            (rest, base) = (more, end);
         }
+        run_chunks(counts.into_iter().map(|(base, counts)| {
+            move || {
+                counts.fill(0);
+                for &(b, _) in keys {
+                    if let Some(count) = (b as usize + 2).checked_sub(base).and_then(|i| counts.get_mut(i)) {
+                        *count += 1;
+                    }
+                }
+            }
+        }));
         // The running sum in a register: each block waits on an add, not on the store before it.
         let mut sum = 0;
         for start in &mut self.block_start {
             sum += *start;
             *start = sum;
         }
-        // Scatter in input order within each block: deterministic. Every slot is written, so
-        // the arrays are only resized (not cleared and filled first: a pass of its own).
+        // Range r fills the entries from where its first block starts, its cursors
+        // `block_start[edge[r] + 1..edge[r + 1] + 1]`. Every slot is written, so the arrays are
+        // only resized (not cleared and filled first: a pass of its own).
         self.entries.resize(len, EMPTY);
         self.entry_cell.resize(len, 0);
-        for (n, &(b, c)) in self.scratch.iter().zip(&self.keys) {
-            let slot = &mut self.block_start[b as usize + 1];
-            self.entries[*slot as usize] = *n;
-            self.entry_cell[*slot as usize] = c;
-            *slot += 1;
-        }
-        // Then by cell within each block, stably, in parts cut between blocks across the cores
-        // (nothing moves across a block's edge).
-        let block_of = |c: u32| (c / self.cols) * self.block_cols + (c % self.cols) / BLOCK_CELLS;
-        let n = chunk_len(len as u32, len);
-        // Where each part starts.
-        let mut cuts = vec![0];
-        let mut at = n;
-        while at < len {
-            while at < len && block_of(self.entry_cell[at]) == block_of(self.entry_cell[at - 1]) {
-                at += 1;
-            }
-            cuts.push(at);
-            at += n;
-        }
+        let starts: Vec<usize> = (edge
+            .iter()
+            .map(|&b| self.block_start.get(b + 1).map_or(len, |&s| s as usize)))
+        .collect();
+        let (items, keys) = (&self.scratch, &self.keys);
+        let mut fills = Vec::with_capacity(ranges);
         let (mut entries, mut cells) = (&mut self.entries[..], &mut self.entry_cell[..]);
-        let mut parts = Vec::with_capacity(cuts.len());
-        for &start in cuts.iter().rev() {
-            let (rest, part) = entries.split_at_mut(start);
-            let (rest_cells, part_cells) = cells.split_at_mut(start);
-            parts.push((part, part_cells));
-            (entries, cells) = (rest, rest_cells);
+        let mut cursors = &mut self.block_start[1..];
+        for r in 0..ranges {
+            let size = starts[r + 1] - starts[r];
+            let (mine, more) = std::mem::take(&mut entries).split_at_mut(size);
+            let (mine_cells, more_cells) = std::mem::take(&mut cells).split_at_mut(size);
+            let (mine_cursors, more_cursors) = std::mem::take(&mut cursors).split_at_mut(edge[r + 1] - edge[r]);
+            fills.push((edge[r], starts[r], mine, mine_cells, mine_cursors));
+            (entries, cells, cursors) = (more, more_cells, more_cursors);
         }
-        run_chunks(
-            parts
-                .into_iter()
-                .map(|(entries, cells)| move || sort_by_cell(entries, cells)),
-        );
+        run_chunks(fills.into_iter().map(|(first, start, entries, cells, cursors)| {
+            move || {
+                for (n, &(b, c)) in items.iter().zip(keys) {
+                    if let Some(slot) = (b as usize).checked_sub(first).and_then(|i| cursors.get_mut(i)) {
+                        let at = *slot as usize - start;
+                        (entries[at], cells[at]) = (*n, c);
+                        *slot += 1;
+                    }
+                }
+                // Then by cell within each block, stably (nothing moves across a block's edge).
+                sort_by_cell(entries, cells);
+            }
+        }));
     }
 
     /// Creatures in the index.
@@ -361,6 +376,42 @@ mod tests {
             serial,
             radius: 0.5,
             ..EMPTY
+        }
+    }
+
+    #[test]
+    fn an_index_built_in_ranges_across_the_cores_visits_cell_by_cell_in_input_order() {
+        bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
+        let mut grid = NeighbourGrid::new(Vec2::new(60.0, 40.0), 1.5);
+        // A crowd above the parallel size, scattered by a fixed hash, some sharing cells.
+        let items: Vec<_> = (0..6000u32)
+            .map(|i| {
+                let h = i.wrapping_mul(2_654_435_761);
+                at(
+                    (h % 1200) as f32 / 10.0 - 60.0,
+                    (h / 1200 % 800) as f32 / 10.0 - 40.0,
+                    i,
+                )
+            })
+            .collect();
+        grid.rebuild(items.iter().copied());
+        for (k, p) in [
+            (0, Vec2::ZERO),
+            (1, Vec2::new(-59.0, 39.0)),
+            (2, Vec2::new(30.3, -12.7)),
+        ] {
+            let mut found = Vec::new();
+            grid.for_each_within(p, 4.0, |n| found.push(n.serial));
+            // Row by row, cell by cell, and in input order within a cell.
+            let cell = |n: &Neighbour| {
+                let (x, y) = grid.cell_xy(n.position);
+                (y, x)
+            };
+            let mut want: Vec<&Neighbour> = items.iter().filter(|n| n.position.distance(p) <= 4.0).collect();
+            want.sort_by_key(|n| (cell(n), n.serial));
+            let want: Vec<u32> = want.iter().map(|n| n.serial).collect();
+            assert!(!want.is_empty(), "query {k}");
+            assert_eq!(found, want, "query {k}");
         }
     }
 
