@@ -292,9 +292,8 @@ impl NeighbourGrid {
     }
 }
 
-/// Sorts `entries` by their `cells`, stably: by insertion, each out of order entry shifted by
-/// hand (they are few and near, a block holding a creature or two; a call to `rotate_right`, a
-/// `memmove`, each time was a third of a rebuild).
+/// Sorts `entries` by their `cells`, stably: by insertion, since an entry out of order is rare
+/// and near its place (a block holds a creature or two).
 fn sort_by_cell(entries: &mut [Neighbour], cells: &mut [u32]) {
     for i in 1..cells.len() {
         let c = cells[i];
