@@ -160,15 +160,16 @@ fn enter_point_mass(
     }
 }
 
-/// Whether a planar creature is behind its frame. A creature that nothing reads between two
-/// steering decisions (far from the puck and the walls, not waiting to switch, not steered by
-/// a player: decided with the contacts at each decision) keeps the state of its decision's tick
-/// while the frame's ticks go by, and is moved on to the frame's last tick in one step at that
-/// tick, or as soon as something needs it sooner: the same closed form from the same start as
-/// a tick at a time, so the same state bit for bit, for one pass over a crowd a frame.
+/// Whether a planar creature is behind its frame. A creature that nothing reads before the next
+/// steering decision (far from the puck and the walls, clear of other creatures, not waiting to
+/// switch, not steered by a player: planned at each decision before anything moves, see
+/// `outcome::plan_frames`) keeps the state of its frame's start while the frame's ticks go by,
+/// and is moved on to the frame's last tick in one step at that tick, or as soon as something
+/// needs it sooner: the same closed form from the same start as a tick at a time, so the same
+/// state bit for bit, for one pass over a crowd a frame.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStep {
-    /// Holds the state of its frame's decision tick: the frame's ticks since are still to step.
+    /// Holds the state of its frame's start: the frame's ticks are still to step.
     pub behind: bool,
 }
 
@@ -183,16 +184,17 @@ pub struct FrameStepping {
 }
 
 /// Where a planar creature's current stretch of motion began: the state and gait it started
-/// from, the tick that state is of, and the velocity and level it moves at; and what was worked
-/// out from it last. A stretch begins on the tick after each decision, and again wherever
-/// anything else has written the state since (a collision, a switch, a player's new velocity):
-/// each tick's state is worked out from the stretch's start, not from the tick before.
+/// from, its first tick, and the velocity and level it moves at; and what was worked out from
+/// it last. A stretch begins at each decision's tick (from the frame's start, with the new
+/// desired velocity), and again wherever anything else has written the state since (a
+/// collision, a switch, a player's new velocity): each tick's state is worked out from the
+/// stretch's start, not from the tick before.
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct PlanarSegment {
     start: PlanarState,
     start_gait: GaitPhase,
-    /// The tick at whose end `start` is.
-    tick: u64,
+    /// The stretch's first tick: `start` is the state at its beginning.
+    first_tick: u64,
     desired: Vec2,
     lod: Lod,
     published: PlanarState,
@@ -200,12 +202,12 @@ pub struct PlanarSegment {
 }
 
 impl PlanarSegment {
-    /// A stretch starting from the creature as it is, at the end of tick `tick`.
-    fn begin(state: &PlanarState, gait: &GaitPhase, desired: Vec2, lod: Lod, tick: u64) -> Self {
+    /// A stretch starting from the creature as it is, at the beginning of tick `first_tick`.
+    fn begin(state: &PlanarState, gait: &GaitPhase, desired: Vec2, lod: Lod, first_tick: u64) -> Self {
         Self {
             start: *state,
             start_gait: *gait,
-            tick,
+            first_tick,
             desired,
             lod,
             published: *state,
@@ -277,9 +279,9 @@ impl<'a> PlanarStepper<'a> {
     }
 
     /// Moves a creature on its stretch to the end of this tick. A new stretch begins from where
-    /// the creature is: as of the end of tick `since` where given (the first tick after a
-    /// decision; a creature behind its frame, held at its decision's tick), else as of the last
-    /// tick if anything but the stepper has moved it since.
+    /// the creature is: with its first tick `first_tick` where given (a decision's tick; a
+    /// creature behind its frame, held at the frame's start), else with this tick if anything but
+    /// the stepper has moved it since the last.
     pub fn follow(
         &self,
         creature: &Creature,
@@ -287,27 +289,26 @@ impl<'a> PlanarStepper<'a> {
         desired: Vec2,
         (state, gait, pose): Moving,
         segment: &mut PlanarSegment,
-        since: Option<u64>,
+        first_tick: Option<u64>,
     ) {
-        match since {
+        match first_tick {
             Some(tick) => *segment = PlanarSegment::begin(state, gait, desired, lod, tick),
             None if !segment.holds(state, gait, desired, lod) => {
-                *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick - 1);
+                *segment = PlanarSegment::begin(state, gait, desired, lod, self.clock.tick);
             }
             None => {}
         }
         (*state, *gait) = (segment.start, segment.start_gait);
-        let ticks = self.clock.tick - segment.tick;
+        let ticks = self.clock.tick + 1 - segment.first_tick;
         self.advance(creature, lod, desired, (state, gait, pose), ticks);
         (segment.published, segment.published_gait) = (*state, *gait);
     }
 }
 
 /// The point-mass and hybrid levels: one planar model; the hybrid also plays the gait table.
-/// On a decision's tick every creature moves one tick from where it is (the new desired
-/// velocity starts there); after it, each follows its stretch, and a creature behind its frame
-/// waits for the frame's last tick.
-fn step_point_masses(
+/// Each creature follows its stretch, begun at the decision's tick from the frame's start; a
+/// creature behind its frame waits for the frame's last tick and is moved the whole frame then.
+pub(crate) fn step_point_masses(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
     kinds: Res<KindTable>,
@@ -323,24 +324,20 @@ fn step_point_masses(
     let stepper = PlanarStepper::new(&kinds, &clock);
     let in_frame = clock.tick_in_frame();
     let last_of_frame = in_frame + 1 == u64::from(clock.ticks_per_decision);
-    let mid_frame = in_frame > 0 && !last_of_frame;
     let step = |creature: &Creature,
                 lod: Lod,
                 desired: Vec2,
                 moving: Moving<'_>,
                 frame: &mut FrameStep,
                 segment: &mut PlanarSegment| {
-        match (frame.behind, in_frame) {
-            (true, _) if !last_of_frame => {}
-            (true, _) => {
+        if frame.behind {
+            if last_of_frame {
                 frame.behind = false;
-                stepper.advance(creature, lod, desired, moving, in_frame);
+                stepper.advance(creature, lod, desired, moving, in_frame + 1);
             }
-            (false, 0) => stepper.advance(creature, lod, desired, moving, 1),
-            (false, _) => {
-                let since = (in_frame == 1).then(|| clock.tick - 1);
-                stepper.follow(creature, lod, desired, moving, segment, since);
-            }
+        } else {
+            let first_tick = (in_frame == 0).then_some(clock.tick);
+            stepper.follow(creature, lod, desired, moving, segment, first_tick);
         }
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
@@ -358,7 +355,7 @@ fn step_point_masses(
             .zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)));
         run_chunks(chunks.map(|((((c, l), d), ((s, g), p)), (f, seg))| {
             move || {
-                if mid_frame {
+                if !last_of_frame {
                     // Only the creatures not behind move: found by a scan of their flags alone,
                     // not a walk over every column (in a crowd nearly all are behind).
                     let mut i = 0;

@@ -28,7 +28,7 @@ use crate::kind::{Creature, KindParams, KindTable};
 use crate::lod::{
     BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SwitchProbe, SwitchTally,
 };
-use crate::models::point_mass::{FrameStep, FrameStepping, PlanarSegment, PlanarStepper};
+use crate::models::point_mass::{FrameStep, FrameStepping, PlanarSegment, PlanarStepper, step_point_masses};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
 
@@ -168,9 +168,9 @@ struct NearPuckOrWall {
 /// position 1,500 m from the centre rounds by about 0.1 mm a tick).
 const REACH_SLACK_M: f32 = 0.01;
 
-/// Whether a creature, at its state after this decision's contacts, could reach the puck or a
-/// wall within `frame_s`. A planar body's speed between decisions stays below the larger of its
-/// speed now and its top speed (`planar_after` moves it toward a target within the top speed).
+/// Whether a creature, at its state at a frame's start, could reach the puck or a wall within
+/// `frame_s`. A planar body's speed between decisions stays below the larger of its speed now
+/// and its top speed (`planar_after` moves it toward a target within the top speed).
 fn could_reach_puck_or_wall(
     state: &PlanarState,
     record: &CollisionRecord,
@@ -188,26 +188,98 @@ fn could_reach_puck_or_wall(
         || (state.position.abs() + Vec2::splat(reach + r)).cmpge(half).any()
 }
 
-/// What a planar creature's frame depends on besides its contacts: whether it may fall behind
-/// its frame ([`FrameStep`]), and what catching it up takes.
+/// Whether steering, at this decision, saw no other creature near enough to touch this one at
+/// the decision's contact check: its [`Clearance`] is wider than any footprint's reach and a
+/// tick of its motion at `speed_m_per_s` (the index holds where the creatures were before it).
+fn clear_of_creatures(clearance: &Clearance, kind: &KindParams, widest_m: f32, speed_m_per_s: f32, dt: f32) -> bool {
+    clearance.clear_m > kind.radius_m + widest_m + speed_m_per_s * dt + REACH_SLACK_M
+}
+
+/// What says whether anything reads a planar creature before the next decision.
 type FramePlan<'a> = (
+    &'a Creature,
+    &'a PlanarState,
+    &'a CollisionRecord,
+    &'a Clearance,
     &'a Lod,
     &'a LevelChoice,
     Has<SwitchProbe>,
     Has<PlayerControlled>,
+);
+
+/// At each decision, before anything moves: the planar creatures that nothing reads before the
+/// next decision fall behind their frame ([`FrameStep`]). Those are the ones that touch
+/// nothing, that no other creature is near enough to touch at this decision's check (steering's
+/// [`Clearance`]), that cannot reach the puck or a wall within the frame, and that do not wait
+/// to switch, are not measured after a switch and are not steered by a player. Every contact
+/// check until the next decision would find nothing, so each passes them by.
+#[allow(clippy::too_many_arguments)]
+fn plan_frames(
+    clock: Res<SimClock>,
+    config: Res<SimConfig>,
+    kinds: Res<KindTable>,
+    puck: Res<PuckState>,
+    court: Res<Court>,
+    grid: Res<NeighbourGrid>,
+    stepping: Option<Res<FrameStepping>>,
+    mut creatures: Query<(FramePlan, &mut FrameStep), Without<AtRigid>>,
+) {
+    // A frame of one or two ticks has nothing to gain.
+    if !clock.is_decision_tick() || stepping.is_some_and(|s| !s.enabled) || clock.ticks_per_decision <= 2 {
+        return;
+    }
+    let frame_s = clock.dt * clock.ticks_per_decision as f32;
+    let puck_reach_m = config.arena.puck.speed_m_per_s * frame_s;
+    let widest_m = grid.fastest_and_widest().1;
+    let plan = |creature: &Creature,
+                state: &PlanarState,
+                record: &CollisionRecord,
+                clearance: &Clearance,
+                lod: Lod,
+                choice: &LevelChoice,
+                frame: &mut FrameStep| {
+        let kind = &kinds[creature.kind];
+        // It moves a tick before the decision's check: at most at this speed.
+        let speed = state.velocity.length().max(kind.top_speed_m_per_s);
+        frame.behind = choice.wanted == lod
+            && !record.touching.iter().any(|&t| t)
+            && clear_of_creatures(clearance, kind, widest_m, speed, clock.dt)
+            && !could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
+    };
+    for ((creature, state, record, clearance, lod, choice, probed, player), mut frame) in
+        creatures.contiguous_iter_mut().expect(DENSE)
+    {
+        let frame = frame.bypass_change_detection();
+        if probed || player {
+            frame.fill(FrameStep { behind: false });
+            continue;
+        }
+        let n = chunk_len(config.scenario.creature_count(), creature.len());
+        let chunks = (creature.chunks(n).zip(state.chunks(n)).zip(record.chunks(n)))
+            .zip((clearance.chunks(n).zip(lod.chunks(n)).zip(choice.chunks(n))).zip(frame.chunks_mut(n)));
+        run_chunks(chunks.map(|(((c, s), r), (((cl, l), ch), f))| {
+            move || {
+                let rows = (c.iter().zip(s).zip(r)).zip((cl.iter().zip(l).zip(ch)).zip(f));
+                for (((c, s), r), (((cl, l), ch), f)) in rows {
+                    plan(c, s, r, cl, *l, ch, f);
+                }
+            }
+        }));
+    }
+}
+
+/// What catching up a planar creature behind its frame takes.
+type CatchUp<'a> = (
+    &'a Lod,
     &'a DesiredVelocity,
     &'a mut GaitPhase,
     &'a mut GaitPose,
     (&'a mut FrameStep, &'a mut PlanarSegment),
 );
 
-/// Puck, wall and (at each decision) creature contacts of the planar creatures. At each
-/// decision it also says which creatures nothing will read before the next one: none that
-/// could reach the puck or a wall, touches anything, waits to switch, is being measured
-/// after a switch or is steered by a player. Those fall behind their frame ([`FrameStep`]);
-/// checking every creature mid-frame (after a respawn) passes them by, as they cannot touch
-/// the puck or a wall before the next decision, unless the puck went farther than its reach,
-/// when they are caught up first.
+/// Puck, wall and (at each decision) creature contacts of the planar creatures. The creatures
+/// behind their frame ([`plan_frames`]) are passed by, as nothing can touch them before the next
+/// decision, unless the puck went farther than its reach: then they are caught up first.
 #[allow(clippy::too_many_arguments)]
 fn detect_collisions(
     clock: Res<SimClock>,
@@ -218,7 +290,6 @@ fn detect_collisions(
     grid: Res<NeighbourGrid>,
     falls: Res<FallQueue>,
     tally: Res<Tally>,
-    stepping: Option<Res<FrameStepping>>,
     mut switched: MessageReader<LevelSwitched>,
     mut watch: Local<NearPuckOrWall>,
     mut chosen: Local<Parallel<Vec<Entity>>>,
@@ -229,7 +300,8 @@ fn detect_collisions(
             &mut PlanarState,
             &mut CollisionRecord,
             &Clearance,
-            FramePlan,
+            Has<PlayerControlled>,
+            CatchUp,
         ),
         Without<AtRigid>,
     >,
@@ -255,7 +327,7 @@ fn detect_collisions(
         }
         if !watch.check_all {
             for &entity in &watch.near {
-                if let Ok((entity, creature, mut state, mut record, _, _)) = creatures.get_mut(entity) {
+                if let Ok((entity, creature, mut state, mut record, ..)) = creatures.get_mut(entity) {
                     collide(entity, creature, &mut state, &mut record, None);
                 }
             }
@@ -264,8 +336,6 @@ fn detect_collisions(
     }
     let frame_s = clock.dt * clock.ticks_per_decision as f32;
     let puck_reach_m = config.arena.puck.speed_m_per_s * frame_s;
-    // A frame of one or two ticks has nothing to gain.
-    let may_fall_behind = decision && stepping.is_none_or(|s| s.enabled) && clock.ticks_per_decision > 2;
     let stepper = PlanarStepper::new(&kinds, &clock);
     let in_frame = clock.tick_in_frame();
     let widest_m = grid.fastest_and_widest().1;
@@ -275,39 +345,27 @@ fn detect_collisions(
                  state: &mut PlanarState,
                  record: &mut CollisionRecord,
                  clearance: &Clearance,
-                 plan: FramePlanItem,
-                 frame: &mut FrameStep,
-                 segment: &mut PlanarSegment| {
-        let (lod, choice, probed, player, desired, gait, pose) = plan;
+                 player: bool,
+                 (lod, desired, gait, pose, (frame, segment)): CatchUpItem| {
         if frame.behind {
             if !puck_outran {
                 return;
             }
-            let since = Some(clock.tick - in_frame);
-            stepper.follow(creature, *lod, desired.0, (state, gait, pose), segment, since);
+            // Moved from the frame's start: its stretch begins at the decision's tick.
+            let first_tick = Some(clock.tick - in_frame);
+            stepper.follow(creature, *lod, desired.0, (state, gait, pose), segment, first_tick);
             frame.behind = false;
         }
         let kind = &kinds[creature.kind];
         // Steering saw no creature near enough to touch now (but a player's creature does not steer).
-        let clear = !player
-            && clearance.clear_m > kind.radius_m + widest_m + state.velocity.length() * clock.dt + REACH_SLACK_M;
+        let clear = !player && clear_of_creatures(clearance, kind, widest_m, state.velocity.length(), clock.dt);
         collide(entity, creature, state, record, (decision && !clear).then_some(&*grid));
         if decision && clear {
             record.note(Obstacle::Creature, false);
         }
-        if !decision {
-            return;
-        }
-        let near = could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
-        if near {
+        if decision && could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s) {
             chosen_now.borrow_local_mut().push(entity);
         }
-        frame.behind = may_fall_behind
-            && !near
-            && !record.touching.iter().any(|&t| t)
-            && choice.wanted == *lod
-            && !probed
-            && !player;
     };
     // Nothing watches these components' change ticks: the loops leave them alone (writing
     // them is a pass over a column of its own).
@@ -317,7 +375,8 @@ fn detect_collisions(
         mut state,
         mut record,
         clearance,
-        (lod, choice, probed, player, desired, mut gait, mut pose, (mut frame, mut segment)),
+        player,
+        (lod, desired, mut gait, mut pose, (mut frame, mut segment)),
     ) in creatures.contiguous_iter_mut().expect(DENSE)
     {
         let n = chunk_len(config.scenario.creature_count(), entity.len());
@@ -331,21 +390,18 @@ fn detect_collisions(
         let chunks = ((entity.chunks(n).zip(creature.chunks(n)).zip(clearance.chunks(n)))
             .zip(state.chunks_mut(n).zip(record.chunks_mut(n))))
         .zip(
-            (lod.chunks(n).zip(choice.chunks(n)).zip(desired.chunks(n)))
+            (lod.chunks(n).zip(desired.chunks(n)))
                 .zip((gait.chunks_mut(n).zip(pose.chunks_mut(n))).zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)))),
         );
-        run_chunks(
-            chunks.map(|((((e, c), cl), (s, r)), (((l, ch), d), ((g, p), (f, seg))))| {
-                move || {
-                    let rows = ((e.iter().zip(c).zip(cl)).zip(s.iter_mut().zip(r))).zip(
-                        (l.iter().zip(ch).zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut().zip(seg))),
-                    );
-                    for ((((e, c), cl), (s, r)), (((l, ch), d), ((g, p), (f, seg)))) in rows {
-                        check(*e, c, s, r, cl, (l, ch, probed, player, d, g, p), f, seg);
-                    }
+        run_chunks(chunks.map(|((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg))))| {
+            move || {
+                let rows = ((e.iter().zip(c).zip(cl)).zip(s.iter_mut().zip(r)))
+                    .zip((l.iter().zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut().zip(seg))));
+                for ((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg)))) in rows {
+                    check(*e, c, s, r, cl, player, (l, d, g, p, (f, seg)));
                 }
-            }),
-        );
+            }
+        }));
     }
     if decision {
         switched.clear();
@@ -360,15 +416,13 @@ fn detect_collisions(
     }
 }
 
-/// A row of [`FramePlan`] as the loop hands it on (the frame step apart).
-type FramePlanItem<'a> = (
+/// A row of [`CatchUp`] as the loop hands it on.
+type CatchUpItem<'a> = (
     &'a Lod,
-    &'a LevelChoice,
-    bool,
-    bool,
     &'a DesiredVelocity,
     &'a mut GaitPhase,
     &'a mut GaitPose,
+    (&'a mut FrameStep, &'a mut PlanarSegment),
 );
 
 /// Removes the fallen and starts a new creature of the same kind in a free spot.
@@ -548,6 +602,7 @@ pub(super) fn plugin(app: &mut App) {
         .init_resource::<Tally>()
         .add_systems(SimStart, reset_tally)
         .add_systems(schedule, detect_collisions.in_set(SimStage::Observe))
+        .add_systems(schedule, plan_frames.in_set(SimStage::Step).before(step_point_masses))
         .add_systems(
             schedule,
             (

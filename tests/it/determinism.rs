@@ -64,6 +64,18 @@ fn stepped(
     (sim.state_digest(), summary)
 }
 
+/// Runs the rest of a frame, one tick at a time, from its decision's tick.
+fn finish_frame(sim: &mut simlod::headless::HeadlessSim) {
+    let ticks = sim
+        .app
+        .world()
+        .resource::<simlod::contract::SimClock>()
+        .ticks_per_decision;
+    for _ in 1..ticks {
+        tick_and_count_behind(sim);
+    }
+}
+
 /// Runs one tick; how many creatures are behind their frame after it.
 fn tick_and_count_behind(sim: &mut simlod::headless::HeadlessSim) -> usize {
     simlod::headless::run_ticks_per_update(sim.app.world_mut(), 1);
@@ -77,15 +89,20 @@ fn creatures_stepped_a_frame_at_a_time_end_where_they_would_a_tick_at_a_time() {
     use simlod::lod::LevelPolicy::*;
     for policy in [AllPointMass, AllHybrid, Influence, Combined, Budget] {
         let config = scene(&[("hopper", 90), ("biped", 30)], policy);
-        // Mid-frame, after 4 s: the creatures behind their frame.
+        // After 4 s, the decision's tick: the creatures behind their frame. Compared at the
+        // frame's end (mid-frame, one behind holds the frame's start).
         let mut behind = 0;
-        let on = stepped(&config, true, 4.0, |sim| behind = tick_and_count_behind(sim));
+        let on = stepped(&config, true, 4.0, |sim| {
+            behind = tick_and_count_behind(sim);
+            finish_frame(sim);
+        });
         let off = stepped(&config, false, 4.0, |sim| {
             assert_eq!(
                 tick_and_count_behind(sim),
                 0,
                 "{policy:?}: none falls behind when it is off"
             );
+            finish_frame(sim);
         });
         assert_eq!(on, off, "{policy:?}");
         assert!(on.1.collisions.iter().any(|(_, n)| n > 0), "{policy:?}: {:?}", on.1);
@@ -97,28 +114,31 @@ fn creatures_stepped_a_frame_at_a_time_end_where_they_would_a_tick_at_a_time() {
 fn creatures_behind_their_frame_are_caught_up_when_the_puck_goes_farther_than_it_could() {
     let config = scene(&[("hopper", 200)], simlod::lod::LevelPolicy::AllPointMass);
     let half = config.arena.half_extents();
-    // Mid-frame, the puck is put down touching the creature farthest from it (and from the
-    // walls): it and the others behind their frame are stepped to the tick before any is
-    // checked against the puck.
+    // The creature farthest from the puck (and from the walls), chosen at the frame's start,
+    // where every creature is up to date; on the decision's tick, the puck is put down touching
+    // where it was then: it and the others behind their frame are stepped to the tick before
+    // any is checked against the puck.
     let teleport = |sim: &mut simlod::headless::HeadlessSim, was_behind: &mut bool| {
-        tick_and_count_behind(sim);
         let world = sim.app.world_mut();
         let puck = *world.resource::<simlod::arena::PuckState>();
-        let (target, behind) = world
-            .query::<(&PlanarState, &FrameStep)>()
+        let (serial, target) = world
+            .query::<(&simlod::kind::Creature, &PlanarState)>()
             .iter(world)
-            .filter(|(s, _)| (half - s.position.abs()).min_element() > 3.0)
-            .map(|(s, f)| (s.position, f.behind))
-            .max_by(|a, b| a.0.distance(puck.position).total_cmp(&b.0.distance(puck.position)))
+            .filter(|(_, s)| (half - s.position.abs()).min_element() > 3.0)
+            .map(|(c, s)| (c.serial, s.position))
+            .max_by(|a, b| a.1.distance(puck.position).total_cmp(&b.1.distance(puck.position)))
             .unwrap();
-        *was_behind = behind;
+        tick_and_count_behind(sim);
+        let world = sim.app.world_mut();
+        *was_behind = world
+            .query::<(&simlod::kind::Creature, &FrameStep)>()
+            .iter(world)
+            .any(|(c, f)| c.serial == serial && f.behind);
         let mut puck = world.query_filtered::<&mut Transform, With<simlod::arena::Puck>>();
         let mut transform = puck.single_mut(world).unwrap();
         transform.translation.x = target.x + 2.2;
         transform.translation.z = target.y;
-        let behind_after: Vec<usize> = (0..3).map(|_| tick_and_count_behind(sim)).collect();
-        simlod::headless::run_ticks_per_update(sim.app.world_mut(), 8);
-        behind_after
+        (0..3).map(|_| tick_and_count_behind(sim)).collect()
     };
     let mut was_behind = false;
     let mut behind_after = Vec::new();
