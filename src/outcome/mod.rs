@@ -26,7 +26,7 @@ use crate::contract::{DesiredVelocity, GaitPhase, PlanarState, PlayerControlled}
 use crate::creature::{Clearance, SerialCounter, creature_bundle, find_free_spot};
 use crate::kind::{Creature, KindParams, KindTable};
 use crate::lod::{
-    BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SwitchProbe, SwitchTally,
+    BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SimCamera, SwitchProbe, SwitchTally,
 };
 use crate::models::point_mass::{FrameStep, FrameStepping, PlanarSegment, PlanarStepper, step_point_masses};
 use crate::sense::NeighbourGrid;
@@ -211,8 +211,9 @@ type FramePlan<'a> = (
 /// next decision fall behind their frame ([`FrameStep`]). Those are the ones that touch
 /// nothing, that no other creature is near enough to touch at this decision's check (steering's
 /// [`Clearance`]), that cannot reach the puck or a wall within the frame, and that do not wait
-/// to switch, are not measured after a switch and are not steered by a player. Every contact
-/// check until the next decision would find nothing, so each passes them by.
+/// to switch, are not measured after a switch, are not steered by a player and are not the
+/// one the headless camera follows (it is placed at every tick). Every contact check until the
+/// next decision would find nothing, so each passes them by.
 #[allow(clippy::too_many_arguments)]
 fn plan_frames(
     clock: Res<SimClock>,
@@ -221,6 +222,7 @@ fn plan_frames(
     puck: Res<PuckState>,
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
+    camera: Res<SimCamera>,
     stepping: Option<Res<FrameStepping>>,
     mut creatures: Query<(FramePlan, &mut FrameStep), Without<AtRigid>>,
 ) {
@@ -265,6 +267,9 @@ fn plan_frames(
                 }
             }
         }));
+    }
+    if let Some((_, mut frame)) = camera.following.and_then(|e| creatures.get_mut(e).ok()) {
+        frame.behind = false;
     }
 }
 

@@ -160,3 +160,27 @@ fn creatures_behind_their_frame_are_caught_up_when_the_puck_goes_farther_than_it
             .any(|(o, n)| o == simlod::outcome::Obstacle::Puck && n > 0)
     );
 }
+
+#[test]
+fn the_headless_camera_follows_its_creature_at_every_tick_with_frame_stepping_on() {
+    // The budget (its levels may change, so the camera is placed at every tick), small and with
+    // no rigid level bought for being seen or followed: the followed creature stays planar.
+    let mut config = scene(&[("hopper", 90), ("biped", 30)], simlod::lod::LevelPolicy::Budget);
+    config.rules.budget.player_rigid_weight = 0.0;
+    config.rules.budget.view_rigid_weight = 0.0;
+    config.rules.budget.frame_budget_ms = 0.5;
+    // A second's ticks after 2 s: where the camera is at each, and how many are behind.
+    let watch = |enabled: bool| {
+        let (mut eyes, mut behind) = (Vec::new(), 0);
+        stepped(&config, enabled, 2.0, |sim| {
+            for _ in 0..240 {
+                behind = behind.max(tick_and_count_behind(sim));
+                eyes.push(sim.app.world().resource::<simlod::lod::SimCamera>().eye);
+            }
+        });
+        (eyes, behind)
+    };
+    let (on, behind) = watch(true);
+    assert!(behind > 30, "only {behind} of 120 behind their frame");
+    assert_eq!(on, watch(false).0);
+}
