@@ -162,11 +162,11 @@ fn enter_point_mass(
 
 /// Whether a planar creature is behind its frame. A creature that nothing reads before the next
 /// steering decision (far from the puck and the walls, clear of other creatures, not waiting to
-/// switch, not steered by a player: planned at each decision before anything moves, see
-/// `outcome::plan_frames`) keeps the state of its frame's start while the frame's ticks go by,
-/// and is moved on to the frame's last tick in one step at that tick, or as soon as something
-/// needs it sooner: the same closed form from the same start as a tick at a time, so the same
-/// state bit for bit, for one pass over a crowd a frame.
+/// switch, neither steered by a player nor followed by the headless camera: planned at each
+/// decision before anything moves, see `outcome::plan_frames`) keeps the state of its frame's
+/// start while the frame's ticks go by, and is moved on to the frame's last tick in one step at
+/// that tick, or as soon as something needs it sooner: the same closed form from the same start
+/// as a tick at a time, so the same state bit for bit, for one pass over a crowd a frame.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStep {
     /// Holds the state of its frame's start: the frame's ticks are still to step.
