@@ -310,15 +310,49 @@ pub fn allocate(
     }
 }
 
-/// Whether any creature's cheapest step up fits in `budget_us` beside every creature at its
-/// floor: if not, [`allocate`] gives every creature its floor.
-fn any_step_fits(candidates: &[Candidate], budget_us: f32) -> bool {
-    let floors_us: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
-    let cheapest_us = candidates
-        .iter()
-        .map(Candidate::cheapest_step_above_floor_us)
-        .fold(f32::INFINITY, f32::min);
-    floors_us + cheapest_us <= budget_us
+/// Every creature at its floor, gathered one by one before any benefit is worked out: what
+/// the floors cost, and whether any creature's cheapest step up fits beside them (if not,
+/// [`allocate`] gives every creature its floor, so they are the choice).
+struct Floors {
+    levels: Vec<Lod>,
+    /// What the floors cost, us.
+    cost_us: f32,
+    /// The frame as it will run at the floors (creatures going down still cost their level), us.
+    frame_us: f32,
+    /// The cheapest step up from any floor, us.
+    cheapest_step_us: f32,
+}
+
+impl Floors {
+    fn with_capacity(creatures: usize) -> Self {
+        Self {
+            levels: Vec::with_capacity(creatures),
+            cost_us: 0.0,
+            frame_us: 0.0,
+            cheapest_step_us: f32::INFINITY,
+        }
+    }
+
+    fn add(&mut self, c: &Candidate) {
+        self.levels.push(c.floor);
+        self.cost_us += c.cost_us(c.floor);
+        self.frame_us += c.frame_cost_us(c.floor);
+        self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_above_floor_us());
+    }
+
+    fn any_step_fits(&self, budget_us: f32) -> bool {
+        self.cost_us + self.cheapest_step_us <= budget_us
+    }
+
+    /// The floors as the allocation, within `budget_us` beside a frame's `fixed_us`.
+    fn allocation(self, budget_us: f32, fixed_us: f32) -> Allocation {
+        Allocation {
+            predicted_us: self.frame_us + fixed_us,
+            exceeded: self.frame_us > budget_us - fixed_us,
+            levels: self.levels,
+            settled: 0,
+        }
+    }
 }
 
 /// The adaptive mode's correction of the cost model after one more measured frame: the
@@ -614,7 +648,6 @@ type Creatures<'w, 's> = Query<
 
 /// One decision of the budget policy, in the query's order.
 struct Decision {
-    entities: Vec<Entity>,
     allocation: Allocation,
     /// The creatures searched for contacts with others (by their place in the query, in
     /// order), and how urgent their soonest contact is.
@@ -651,50 +684,43 @@ fn decide(
     budget_us: f32,
 ) -> Decision {
     let costs = config.costs_by_kind();
-    let rows: Vec<_> = creatures.iter().collect();
-    let mut candidates: Vec<Candidate> = rows
-        .iter()
-        .map(|&(_, c, &lod, _, choice)| {
-            let kind = &kinds[c.kind];
-            let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
-            Candidate {
-                serial: c.serial,
-                current: lod,
-                last: choice.wanted,
-                floor: if dwelling { lod } else { kind.levels[0] },
-                levels: &kind.levels,
-                costs: costs[c.kind],
-                benefit: [0.0; 3],
-                settled: true,
-            }
-        })
-        .collect();
+    let candidate = |c: &Creature, lod: Lod, choice: &LevelChoice| {
+        let kind = &kinds[c.kind];
+        let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
+        Candidate {
+            serial: c.serial,
+            current: lod,
+            last: choice.wanted,
+            floor: if dwelling { lod } else { kind.levels[0] },
+            levels: &kind.levels,
+            costs: costs[c.kind],
+            benefit: [0.0; 3],
+            settled: true,
+        }
+    };
+    let mut floors = Floors::with_capacity(creatures.iter().len());
+    for (_, c, &lod, _, choice) in creatures {
+        floors.add(&candidate(c, lod, choice));
+    }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
-    let rules = &config.rules.budget;
-    let room_us = budget_us - config.costs.overhead_us(candidates.len());
-    let (hysteresis, least_per_us) = (rules.hysteresis, rules.least_benefit_per_ms / 1e3);
-    let entities = rows.iter().map(|r| r.0).collect();
+    let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
     // Where not one step up fits, every creature keeps its floor whatever the benefits: they
-    // are not worked out, and the choice costs next to nothing (a crowd far over its budget).
-    if !any_step_fits(&candidates, room_us) {
-        // With no benefit, no step is taken: the floors, over the budget only if the frame
-        // without the choice's charge is.
-        let fixed_us = config.costs.overhead_us(0);
-        let mut allocation = allocate(
-            &mut candidates,
-            budget_us - fixed_us,
-            hysteresis,
-            least_per_us,
-            0.0,
-            |_| 0.0,
-        );
-        allocation.predicted_us += fixed_us;
+    // are not worked out, nor the creatures listed, and the choice costs a pass over them (a
+    // crowd far over its budget). The frame is over the budget only if it is without the
+    // choice's charge.
+    if !floors.any_step_fits(room_us) {
         return Decision {
-            entities,
-            allocation,
+            allocation: floors.allocation(budget_us, config.costs.overhead_us(0)),
             searched: Vec::new(),
         };
     }
+    let rows: Vec<_> = creatures.iter().collect();
+    let mut candidates: Vec<Candidate> = rows
+        .iter()
+        .map(|&(_, c, &lod, _, choice)| candidate(c, lod, choice))
+        .collect();
+    let rules = &config.rules.budget;
+    let (hysteresis, least_per_us) = (rules.hysteresis, rules.least_benefit_per_ms / 1e3);
     // Each creature's bounds are its own, worked out across the cores.
     let mut bounds = vec![Bounds::default(); rows.len()];
     let n = chunk_len(config.scenario.creature_count(), rows.len());
@@ -726,11 +752,7 @@ fn decide(
     });
     searched.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
-    Decision {
-        entities,
-        allocation,
-        searched,
-    }
+    Decision { allocation, searched }
 }
 
 fn scene<'a>(
@@ -840,10 +862,9 @@ fn start_by_budget(
     let now = inputs.clock.seconds() as f32;
     let decision = inputs.decide(&creatures, tally.correction);
     let mut searched = decision.searched.iter().peekable();
-    for (row, (&entity, &level)) in decision.entities.iter().zip(&decision.allocation.levels).enumerate() {
-        let Ok((_, c, &lod, _, mut choice)) = creatures.get_mut(entity) else {
-            continue;
-        };
+    for (row, ((entity, c, &lod, _, mut choice), &level)) in
+        creatures.iter_mut().zip(&decision.allocation.levels).enumerate()
+    {
         if level != lod
             && let Ok((mut gait, mut pose)) = gaits.get_mut(entity)
         {
@@ -897,20 +918,29 @@ mod tests {
         }
     }
 
+    fn floors_of(crowd: &[Candidate]) -> Floors {
+        let mut floors = Floors::with_capacity(crowd.len());
+        crowd.iter().for_each(|c| floors.add(c));
+        floors
+    }
+
     #[test]
     fn where_no_step_up_fits_beside_the_floors_every_creature_keeps_its_floor() {
         // Three at the point mass (1 us each); the cheapest step is to the hybrid (1 us more).
         let crowd: Vec<Candidate> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
         let floors = vec![Lod::PointMass; 3];
         for budget_us in [0.0, 2.0, 3.9] {
-            assert!(!any_step_fits(&crowd, budget_us));
-            assert_eq!(
-                allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 0.0, |_| 0.0).levels,
-                floors,
-                "{budget_us} us"
-            );
+            assert!(!floors_of(&crowd).any_step_fits(budget_us));
+            let allocation = allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 0.0, |_| 0.0);
+            assert_eq!(allocation.levels, floors, "{budget_us} us");
+            // The floors gathered alone are that allocation, a frame's fixed cost beside them.
+            let fixed_us = 0.5;
+            let by_floors = floors_of(&crowd).allocation(budget_us + fixed_us, fixed_us);
+            assert_eq!(by_floors.levels, allocation.levels);
+            assert_eq!(by_floors.exceeded, allocation.exceeded, "{budget_us} us");
+            assert!((by_floors.predicted_us - (allocation.predicted_us + fixed_us)).abs() < 1e-6);
         }
-        assert!(any_step_fits(&crowd, 4.0));
+        assert!(floors_of(&crowd).any_step_fits(4.0));
         assert_ne!(allocate(&mut crowd.clone(), 4.0, 0.0, 0.0, 0.0, |_| 0.0).levels, floors);
         // A rigid creature dwelling at its level: its floor is rigid, its own cost counts.
         let dwelling = Candidate {
@@ -918,8 +948,8 @@ mod tests {
             ..candidate(3, Lod::Rigid, 9.0)
         };
         let crowd = [crowd, vec![dwelling]].concat();
-        assert!(!any_step_fits(&crowd, 103.9));
-        assert!(any_step_fits(&crowd, 104.0));
+        assert!(!floors_of(&crowd).any_step_fits(103.9));
+        assert!(floors_of(&crowd).any_step_fits(104.0));
     }
 
     /// A crowd of `n` with mixed levels and dwells, and each one's exact rigid benefit; half of
