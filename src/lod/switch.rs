@@ -19,6 +19,7 @@ use crate::contract::{CollisionRecord, Counts, SwitchCounts};
 use crate::contract::{DENSE, SimClock, SimStage, SimStart};
 use crate::contract::{GaitPhase, PlanarState};
 use crate::kind::{Creature, KindTable};
+use crate::models::point_mass::FrameStep;
 
 /// A creature changed level.
 #[derive(Message, Clone, Copy, Debug, PartialEq)]
@@ -75,6 +76,7 @@ fn switch_levels(
         &GaitPhase,
         &CollisionRecord,
         (&PlanarState, &GaitPose, Option<&SwitchBlend>, &mut DrawnBefore),
+        &FrameStep,
     )>,
 ) {
     let now = clock.seconds() as f32;
@@ -83,27 +85,36 @@ fn switch_levels(
     let rules_move_levels = policy.is_dynamic();
     // Most ticks nothing switches: one pass over the columns finds the creatures that want
     // another level or might be forced to rigid (in the query's order, so the switches come in
-    // the same order as a pass over every creature). Of those that waited for their window
-    // last tick, the others let go of the drawing they kept.
+    // the same order as a pass over every creature). A creature behind its frame is passed by:
+    // it wanted its level and touched nothing at the decision, and until the frame's last tick
+    // nothing changes either (the choice is made at decisions, and a contact check that finds
+    // it first catches it up). Of those that waited for their window last tick, the others let
+    // go of the drawing they kept.
     let attends = |lod: Lod, choice: &LevelChoice, record: &CollisionRecord| {
         let may_be_forced = rules_move_levels && lod != Lod::Rigid && record.touching.iter().any(|&t| t);
         choice.wanted != lod || may_be_forced
     };
     let (attend, waiting) = &mut *kept;
     attend.clear();
-    for (entity, _, lod, choice, _, record, _) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
-        let rows = entity.iter().zip(lod).zip(choice).zip(record);
-        attend.extend(rows.filter_map(|(((&e, &lod), choice), record)| attends(lod, choice, record).then_some(e)));
+    for (entity, _, lod, choice, _, record, _, frame) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
+        let mut i = 0;
+        while let Some(skip) = frame[i..].iter().position(|f| !f.behind) {
+            i += skip;
+            if attends(lod[i], &choice[i], &record[i]) {
+                attend.push(entity[i]);
+            }
+            i += 1;
+        }
     }
     for entity in waiting.drain(..) {
-        if let Ok((_, _, &lod, choice, _, record, (_, _, _, mut before))) = creatures.get_mut(entity)
+        if let Ok((_, _, &lod, choice, _, record, (_, _, _, mut before), _)) = creatures.get_mut(entity)
             && !attends(lod, &choice, record)
         {
             before.0 = None;
         }
     }
     for &entity in attend.iter() {
-        let Ok((entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before))) =
+        let Ok((entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before), _)) =
             creatures.get_mut(entity)
         else {
             continue;
