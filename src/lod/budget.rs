@@ -323,6 +323,27 @@ struct Floors {
     cheapest_step_us: f32,
 }
 
+/// What one creature at its floor adds to [`Floors`]: the same for every creature of its kind
+/// at that floor and level, so worked out once a decision for each.
+#[derive(Clone, Copy, Debug)]
+struct AtFloor {
+    floor: Lod,
+    cost_us: f32,
+    frame_us: f32,
+    cheapest_step_us: f32,
+}
+
+impl From<&Candidate<'_>> for AtFloor {
+    fn from(c: &Candidate) -> Self {
+        Self {
+            floor: c.floor,
+            cost_us: c.cost_us(c.floor),
+            frame_us: c.frame_cost_us(c.floor),
+            cheapest_step_us: c.cheapest_step_above_floor_us(),
+        }
+    }
+}
+
 impl Floors {
     fn with_capacity(creatures: usize) -> Self {
         Self {
@@ -333,11 +354,11 @@ impl Floors {
         }
     }
 
-    fn add(&mut self, c: &Candidate) {
+    fn add(&mut self, c: AtFloor) {
         self.levels.push(c.floor);
-        self.cost_us += c.cost_us(c.floor);
-        self.frame_us += c.frame_cost_us(c.floor);
-        self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_above_floor_us());
+        self.cost_us += c.cost_us;
+        self.frame_us += c.frame_us;
+        self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
     }
 
     fn any_step_fits(&self, budget_us: f32) -> bool {
@@ -684,23 +705,41 @@ fn decide(
     budget_us: f32,
 ) -> Decision {
     let costs = config.costs_by_kind();
+    let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
+        let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
+        if dwelling { lod } else { kinds[c.kind].levels[0] }
+    };
     let candidate = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let kind = &kinds[c.kind];
-        let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
         Candidate {
             serial: c.serial,
             current: lod,
             last: choice.wanted,
-            floor: if dwelling { lod } else { kind.levels[0] },
+            floor: floor(c, lod, choice),
             levels: &kind.levels,
             costs: costs[c.kind],
             benefit: [0.0; 3],
             settled: true,
         }
     };
+    // Each kind at each floor and level, once.
+    let at_floor: Vec<[[AtFloor; 3]; 3]> = (0..kinds.0.len())
+        .map(|kind| {
+            let c = Creature { kind, serial: 0 };
+            Lod::ALL.map(|floor| {
+                Lod::ALL.map(|current| {
+                    (&Candidate {
+                        floor,
+                        ..candidate(&c, current, &LevelChoice::default())
+                    })
+                        .into()
+                })
+            })
+        })
+        .collect();
     let mut floors = Floors::with_capacity(creatures.iter().len());
     for (_, c, &lod, _, choice) in creatures {
-        floors.add(&candidate(c, lod, choice));
+        floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
@@ -920,7 +959,7 @@ mod tests {
 
     fn floors_of(crowd: &[Candidate]) -> Floors {
         let mut floors = Floors::with_capacity(crowd.len());
-        crowd.iter().for_each(|c| floors.add(c));
+        crowd.iter().for_each(|c| floors.add(c.into()));
         floors
     }
 
