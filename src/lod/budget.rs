@@ -220,6 +220,9 @@ pub fn allocate(
     mut settle: impl FnMut(usize) -> f32,
 ) -> Allocation {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
+    // Whether each is settled, beside the levels: the queue's order is not the creatures', and
+    // a look at a creature for each step that waits in it would miss the cache.
+    let mut settled_now: Vec<bool> = candidates.iter().map(|c| c.settled).collect();
     let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
     // Every creature's steps up its hull (two at most), and the cheapest step of all.
     let mut listed = Vec::with_capacity(2 * candidates.len());
@@ -252,7 +255,7 @@ pub fn allocate(
             break;
         }
         // A step from a level the creature did not reach, or a bound since settled.
-        if levels[step.creature] != step.from || (step.bound && candidates[step.creature].settled) {
+        if levels[step.creature] != step.from || (step.bound && settled_now[step.creature]) {
             continue;
         }
         let c = &mut candidates[step.creature];
@@ -264,7 +267,7 @@ pub fn allocate(
                 running_us += settle_us;
                 settled += 1;
                 c.benefit[Lod::Rigid as usize] = settle(step.creature);
-                c.settled = true;
+                (c.settled, settled_now[step.creature]) = (true, true);
                 follows.extend(c.step_from(step.creature, step.from, hysteresis, least_per_us));
             }
         } else if spent + step.extra_us <= budget_us {
