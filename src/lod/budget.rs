@@ -109,12 +109,14 @@ impl Candidate<'_> {
             .filter(|s| s.ratio >= least_per_us)
     }
 
-    /// Its steps up its upper hull from its floor, in turn.
-    fn hull(&self, creature: usize, hysteresis: f32, least_per_us: f32) -> impl Iterator<Item = Step> + '_ {
-        std::iter::successors(
-            self.step_from(creature, self.floor, hysteresis, least_per_us),
-            move |s| self.step_from(creature, s.to, hysteresis, least_per_us),
-        )
+    /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
+    /// them: each step is written once, where the iterator's moves of it stalled the listing).
+    fn list_hull(&self, creature: usize, hysteresis: f32, least_per_us: f32, listed: &mut Vec<Step>) {
+        let mut next = self.step_from(creature, self.floor, hysteresis, least_per_us);
+        while let Some(step) = next {
+            listed.push(step);
+            next = self.step_from(creature, step.to, hysteresis, least_per_us);
+        }
     }
 
     /// The least any step up from its floor or a level above can cost.
@@ -229,7 +231,7 @@ pub fn allocate(
     let mut cheapest_us = f32::INFINITY;
     for (i, c) in candidates.iter().enumerate() {
         cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us());
-        listed.extend(c.hull(i, hysteresis, least_per_us));
+        c.list_hull(i, hysteresis, least_per_us, &mut listed);
     }
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
