@@ -374,3 +374,64 @@ fn a_search_for_contacts_with_other_creatures_stands_for_the_recheck_time_and_is
         "{rigid_with_dear_searches} against {rigid}"
     );
 }
+
+#[test]
+fn a_budget_cut_below_the_cheapest_levels_keeps_each_creature_in_its_dwell_at_its_level() {
+    // Room for a few rigid creatures: the levels move.
+    let mut sim = HeadlessSim::new(budget_scene(30, 0.5));
+    let min_dwell_s = sim.app.world().resource::<SimConfig>().rules.min_dwell_s;
+    assert!(min_dwell_s >= 0.2, "{min_dwell_s}");
+    // Until a creature has just switched up: it dwells at its level through the next decision.
+    let levels = |sim: &mut HeadlessSim| {
+        let world = sim.app.world_mut();
+        let now = world.resource::<simlod::contract::SimClock>().seconds() as f32;
+        let mut rows: Vec<_> = world
+            .query::<(&Creature, &Lod, &LevelChoice)>()
+            .iter(world)
+            .map(|(c, &l, choice)| (c.serial, l, *choice, now))
+            .collect();
+        rows.sort_by_key(|r| r.0);
+        rows
+    };
+    let just_up = |rows: &[(u32, Lod, LevelChoice, f32)]| -> Vec<u32> {
+        rows.iter()
+            .filter(|(_, l, choice, now)| *l > Lod::PointMass && choice.switched && now - choice.last_switch_s < 0.1)
+            .map(|r| r.0)
+            .collect()
+    };
+    let mut dwelling = Vec::new();
+    for _ in 0..300 {
+        sim.advance_frame();
+        dwelling = just_up(&levels(&mut sim));
+        if !dwelling.is_empty() {
+            break;
+        }
+    }
+    assert!(!dwelling.is_empty(), "no creature went above the point mass");
+    let before = levels(&mut sim);
+    // Now not one step up fits beside the floors: the choice gives the floors at once.
+    sim.app
+        .world_mut()
+        .resource_mut::<SimConfig>()
+        .rules
+        .budget
+        .frame_budget_ms = 0.001;
+    sim.advance_frame();
+    for ((serial, level, ..), (_, _, choice, _)) in before.iter().zip(levels(&mut sim)) {
+        let floor = if dwelling.contains(serial) {
+            *level
+        } else {
+            Lod::PointMass
+        };
+        assert_eq!(choice.wanted, floor, "creature {serial}");
+    }
+    let tally = sim.app.world().resource::<BudgetTally>().clone();
+    assert!(tally.over_budget > 0 && tally.model_us > 100.0, "{tally:?}");
+    // Once the dwell is over, every creature wants the point mass.
+    sim.run_for(f64::from(min_dwell_s) + 0.2);
+    assert!(
+        levels(&mut sim)
+            .iter()
+            .all(|(_, _, choice, _)| choice.wanted == Lod::PointMass)
+    );
+}
