@@ -728,16 +728,21 @@ fn decide(
         }
     };
     // Each kind at each floor and level, once.
-    let at_floor: Vec<[[AtFloor; 3]; 3]> = (0..kinds.0.len())
-        .map(|kind| {
-            let c = Creature { kind, serial: 0 };
+    let at_floor: Vec<[[AtFloor; 3]; 3]> = (kinds.0.iter().zip(&costs))
+        .map(|(kind, &costs)| {
             Lod::ALL.map(|floor| {
                 Lod::ALL.map(|current| {
-                    (&Candidate {
+                    let c = Candidate {
+                        serial: 0,
+                        current,
+                        last: current,
                         floor,
-                        ..candidate(&c, current, &LevelChoice::default())
-                    })
-                        .into()
+                        levels: &kind.levels,
+                        costs,
+                        benefit: [0.0; 3],
+                        settled: true,
+                    };
+                    (&c).into()
                 })
             })
         })
