@@ -27,12 +27,17 @@ pub const DENSE: &str = "table components and archetype filters only: a dense qu
 /// How many of `len` items (a table's column) each thread takes in a loop over creatures: all
 /// of them below [`PARALLEL_MIN_CREATURES`], or where there is no compute pool (outside an app).
 pub fn chunk_len(population: u32, len: usize) -> usize {
-    let threads = if population < PARALLEL_MIN_CREATURES {
+    len.div_ceil(threads_for(population)).max(1)
+}
+
+/// The threads a loop over a `population` of creatures runs on: one below
+/// [`PARALLEL_MIN_CREATURES`] or where there is no compute pool (outside an app).
+pub fn threads_for(population: u32) -> usize {
+    if population < PARALLEL_MIN_CREATURES {
         1
     } else {
         bevy::tasks::ComputeTaskPool::try_get().map_or(1, |pool| pool.thread_num().max(1))
-    };
-    len.div_ceil(threads).max(1)
+    }
 }
 
 /// Runs one job per chunk of [`chunk_len`] across the compute pool; a lone job runs here.

@@ -32,7 +32,7 @@ use crate::contract::GaitPose;
 use crate::contract::SimClock;
 use crate::contract::{GaitPhase, PlanarState};
 use crate::contract::{SimStage, SimStart, StartStage};
-use crate::contract::{chunk_len, run_chunks};
+use crate::contract::{chunk_len, run_chunks, threads_for};
 use crate::kind::{Creature, KindParams, KindTable, starting_gait};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
@@ -84,7 +84,8 @@ impl Candidate<'_> {
 
     /// The next step up its upper hull of cost and benefit from `at`: the most benefit per
     /// microsecond, ties to the lower level; none below `least_per_us`.
-    fn step_from(&self, creature: usize, at: Lod, hysteresis: f32, least_per_us: f32) -> Option<Step> {
+    /// `settle_us` is what settling a bound costs (see [`Step::need_us`]).
+    fn step_from(&self, creature: u32, at: Lod, hysteresis: f32, least_per_us: f32, settle_us: f32) -> Option<Step> {
         let (cost, value) = (self.cost_us(at), self.value(at, hysteresis));
         self.levels
             .iter()
@@ -94,15 +95,21 @@ impl Candidate<'_> {
                 let extra_us = self.cost_us(to) - cost;
                 let gain = self.value(to, hysteresis) - value;
                 let ratio = if extra_us > 0.0 { gain / extra_us } else { f32::INFINITY };
+                // Only the rigid benefit is ever a bound: a step to another level is exact.
+                let bound = !self.settled && to == Lod::Rigid;
                 Step {
                     ratio,
-                    // Only the rigid benefit is ever a bound: a step to another level is exact.
-                    bound: !self.settled && to == Lod::Rigid,
+                    bound,
                     serial: self.serial,
                     creature,
                     from: at,
                     to,
                     extra_us,
+                    need_us: if bound {
+                        settle_us + self.cheapest_step_us(at)
+                    } else {
+                        extra_us
+                    },
                 }
             })
             .max_by(|a, b| a.ratio.total_cmp(&b.ratio).then(b.to.cmp(&a.to)))
@@ -111,11 +118,11 @@ impl Candidate<'_> {
 
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
-    fn list_hull(&self, creature: usize, hysteresis: f32, least_per_us: f32, listed: &mut Vec<Step>) {
-        let mut next = self.step_from(creature, self.floor, hysteresis, least_per_us);
+    fn list_hull(&self, creature: u32, hysteresis: f32, least_per_us: f32, settle_us: f32, listed: &mut Vec<Step>) {
+        let mut next = self.step_from(creature, self.floor, hysteresis, least_per_us, settle_us);
         while let Some(step) = next {
             listed.push(step);
-            next = self.step_from(creature, step.to, hysteresis, least_per_us);
+            next = self.step_from(creature, step.to, hysteresis, least_per_us, settle_us);
         }
     }
 
@@ -141,15 +148,16 @@ impl Candidate<'_> {
 
 /// The levels chosen, and what the frame is predicted to cost.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Allocation {
+pub struct Allocation<S = ()> {
     /// One per candidate, in the candidates' order.
     pub levels: Vec<Lod>,
     /// The frame's predicted simulation time at these levels, us per 1/30 s.
     pub predicted_us: f32,
     /// Even the cheapest allowed levels cost more than the budget.
     pub exceeded: bool,
-    /// Candidates whose benefit had to be settled (each one's search for contacts).
-    pub settled: usize,
+    /// Candidates whose benefit had to be settled (each one's search for contacts), in the
+    /// order settled, with what the settling returned beside the benefit.
+    pub settled: Vec<(usize, S)>,
 }
 
 /// One step up a creature's levels on the knapsack's upper hull; while `bound`, its ratio is
@@ -159,10 +167,13 @@ struct Step {
     ratio: f32,
     bound: bool,
     serial: u32,
-    creature: usize,
+    creature: u32,
     from: Lod,
     to: Lod,
     extra_us: f32,
+    /// The least room in the budget the step needs to change anything: its extra cost, or
+    /// while a bound, the search that settles it and the cheapest step after.
+    need_us: f32,
 }
 
 /// The order steps are taken in, greatest first: the most benefit per microsecond, then the
@@ -210,17 +221,20 @@ impl Eq for Step {}
 ///
 /// Incremental (after Funkhouser & Sequin): a candidate not yet `settled` waits in the queue
 /// at the most its steps could be worth, and is settled by `settle` (its exact rigid benefit,
-/// charged `settle_us` of the budget) only when it reaches the front with room left for a
-/// step of its own. Since a bound is never below what it bounds, the steps are taken in the
-/// same order as if every benefit had been exact from the start.
-pub fn allocate(
+/// and whatever else the caller keeps of it; charged `settle_us` of the budget) only when it
+/// reaches the front with room left for a step of its own. Since a bound is never below what it
+/// bounds, the steps are taken in the same order as if every benefit had been exact from the
+/// start. The next bounds in the queue are settled ahead across the cores, as many as the
+/// budget could pay for: `settle` must depend on the candidate alone, and a search made ahead
+/// and never reached is only time lost.
+pub fn allocate<S: Send>(
     candidates: &mut [Candidate],
     budget_us: f32,
     hysteresis: f32,
     least_per_us: f32,
     settle_us: f32,
-    mut settle: impl FnMut(usize) -> f32,
-) -> Allocation {
+    settle: impl Fn(usize) -> (f32, S) + Sync,
+) -> Allocation<S> {
     let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
     // Whether each is settled, beside the levels: the queue's order is not the creatures', and
     // a look at a creature for each step that waits in it would miss the cache.
@@ -231,7 +245,7 @@ pub fn allocate(
     let mut cheapest_us = f32::INFINITY;
     for (i, c) in candidates.iter().enumerate() {
         cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us());
-        c.list_hull(i, hysteresis, least_per_us, &mut listed);
+        c.list_hull(i as u32, hysteresis, least_per_us, settle_us, &mut listed);
     }
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
@@ -240,50 +254,66 @@ pub fn allocate(
     } else {
         listed.clear();
     }
-    let mut listed = listed.into_iter().peekable();
+    // The least room any listed step from each on needs: once the budget has less, the rest of
+    // the list can change nothing and is passed by.
+    let mut need_from = vec![f32::INFINITY; listed.len() + 1];
+    for (i, step) in listed.iter().enumerate().rev() {
+        need_from[i] = need_from[i + 1].min(step.need_us);
+    }
+    let mut next = 0;
     let mut follows = std::collections::BinaryHeap::new();
-    let (mut taken, mut settled) = (Vec::new(), 0);
+    let mut ahead = SettledAhead::new(threads_for(candidates.len() as u32));
+    let (mut taken, mut settled) = (Vec::new(), Vec::new());
     // The frame as it will run (creatures going down still cost their level): a search is
     // paid for at once and never given back, so it must fit beside that too.
     let mut running_us: f32 = candidates.iter().map(|c| c.frame_cost_us(c.floor)).sum();
     loop {
-        let (step, followed) = match (listed.peek(), follows.peek()) {
+        let first = listed.get(next).filter(|_| spent + need_from[next] <= budget_us);
+        let (step, followed) = match (first, follows.peek()) {
             (Some(first), Some(follow)) if follow > first => (follows.pop(), true),
-            (Some(_), _) => (listed.next(), false),
+            (Some(&first), _) => {
+                next += 1;
+                (Some(first), false)
+            }
             (None, _) => (follows.pop(), true),
         };
         let Some(step) = step else { break };
         if spent + cheapest_us > budget_us {
             break;
         }
+        debug_assert!(!(followed && step.bound), "a settled creature's steps are exact");
+        let creature = step.creature as usize;
         // A step from a level the creature did not reach, or a bound since settled.
-        if levels[step.creature] != step.from || (step.bound && settled_now[step.creature]) {
+        if levels[creature] != step.from || (step.bound && settled_now[creature]) {
             continue;
         }
-        let c = &mut candidates[step.creature];
+        let c = &mut candidates[creature];
         if step.bound {
             // Worth settling only with room for the search and a step after it.
             let paid_for = settle_us == 0.0 || running_us + settle_us <= budget_us;
             if paid_for && spent + settle_us + c.cheapest_step_us(step.from) <= budget_us {
+                // Bounds are listed only (a settled creature's steps are exact).
+                let room_us = budget_us - spent.max(running_us);
+                let (benefit, kept) = ahead.take(next - 1, &listed, &settled_now, room_us, settle_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
-                settled += 1;
-                c.benefit[Lod::Rigid as usize] = settle(step.creature);
-                (c.settled, settled_now[step.creature]) = (true, true);
-                follows.extend(c.step_from(step.creature, step.from, hysteresis, least_per_us));
+                settled.push((creature, kept));
+                c.benefit[Lod::Rigid as usize] = benefit;
+                (c.settled, settled_now[creature]) = (true, true);
+                follows.extend(c.step_from(step.creature, step.from, hysteresis, least_per_us, settle_us));
             }
         } else if spent + step.extra_us <= budget_us {
-            levels[step.creature] = step.to;
+            levels[creature] = step.to;
             spent += step.extra_us;
             running_us += c.frame_cost_us(step.to) - c.frame_cost_us(step.from);
             taken.push(step);
             // A listed step's successor is listed too.
             if followed {
-                follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us));
+                follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us, settle_us));
             }
         }
     }
-    let searched_us = settled as f32 * settle_us;
+    let searched_us = settled.len() as f32 * settle_us;
     let frame = |levels: &[Lod]| -> f32 {
         searched_us
             + candidates
@@ -298,8 +328,8 @@ pub fn allocate(
         if predicted_us <= budget_us {
             break;
         }
-        let c = &candidates[step.creature];
-        levels[step.creature] = step.from;
+        let c = &candidates[step.creature as usize];
+        levels[step.creature as usize] = step.from;
         predicted_us += c.frame_cost_us(step.from) - c.frame_cost_us(step.to);
         given_back = true;
     }
@@ -314,6 +344,73 @@ pub fn allocate(
         settled,
     }
 }
+
+/// The bounds further down the queue, settled ahead across the cores: by their place in the
+/// list, in order.
+struct SettledAhead<S> {
+    threads: usize,
+    /// How many bounds the next batch looks ahead for at most (it doubles with each batch).
+    batch: usize,
+    settled: std::collections::VecDeque<(usize, (f32, S))>,
+}
+
+impl<S: Send> SettledAhead<S> {
+    fn new(threads: usize) -> Self {
+        Self {
+            threads,
+            batch: 4 * threads,
+            settled: Default::default(),
+        }
+    }
+
+    /// What settling the bound listed at `at` gives: made ahead, or made now together with the
+    /// next unsettled bounds in the list, no more than `room_us` could pay for at `settle_us`
+    /// each (on one thread, it alone).
+    fn take(
+        &mut self,
+        at: usize,
+        listed: &[Step],
+        settled_now: &[bool],
+        room_us: f32,
+        settle_us: f32,
+        settle: &(impl Fn(usize) -> (f32, S) + Sync),
+    ) -> (f32, S) {
+        while self.settled.front().is_some_and(|s| s.0 < at) {
+            self.settled.pop_front();
+        }
+        if self.settled.front().is_none_or(|s| s.0 != at) {
+            let affordable = if settle_us > 0.0 {
+                (room_us / settle_us) as usize
+            } else {
+                usize::MAX
+            };
+            let most = if self.threads > 1 {
+                self.batch.min(affordable).max(1)
+            } else {
+                1
+            };
+            self.batch = (2 * self.batch).min(MAX_SETTLED_AHEAD);
+            let places: Vec<usize> = (at..listed.len())
+                .filter(|&i| listed[i].bound && !settled_now[listed[i].creature as usize])
+                .take(most)
+                .collect();
+            let mut made: Vec<Option<(f32, S)>> = places.iter().map(|_| None).collect();
+            let n = places.len().div_ceil(self.threads);
+            run_chunks(places.chunks(n).zip(made.chunks_mut(n)).map(|(places, made)| {
+                move || {
+                    for (&i, m) in places.iter().zip(made) {
+                        *m = Some(settle(listed[i].creature as usize));
+                    }
+                }
+            }));
+            self.settled = places.into_iter().zip(made.into_iter().flatten()).collect();
+        }
+        self.settled.pop_front().expect("the bound at the front was settled").1
+    }
+}
+
+/// The most bounds settled ahead at once.
+const MAX_SETTLED_AHEAD: usize = 4096;
 
 /// Every creature at its floor, gathered one by one before any benefit is worked out: what
 /// the floors cost, and whether any creature's cheapest step up fits beside them (if not,
@@ -371,12 +468,12 @@ impl Floors {
     }
 
     /// The floors as the allocation, within `budget_us` beside a frame's `fixed_us`.
-    fn allocation(self, budget_us: f32, fixed_us: f32) -> Allocation {
+    fn allocation<S>(self, budget_us: f32, fixed_us: f32) -> Allocation<S> {
         Allocation {
             predicted_us: self.frame_us + fixed_us,
             exceeded: self.frame_us > budget_us - fixed_us,
             levels: self.levels,
-            settled: 0,
+            settled: Vec::new(),
         }
     }
 }
@@ -483,11 +580,11 @@ impl BudgetTally {
         }
     }
 
-    fn record(&mut self, a: &Allocation) {
+    fn record<S>(&mut self, a: &Allocation<S>) {
         self.model_us = a.predicted_us;
         self.decisions += 1;
         self.over_budget += u64::from(a.exceeded);
-        self.searched += a.settled as u64;
+        self.searched += a.settled.len() as u64;
         self.predicted_sum_us += f64::from(self.predicted_us());
         self.predicted_max_us = self.predicted_max_us.max(self.predicted_us());
     }
@@ -674,10 +771,9 @@ type Creatures<'w, 's> = Query<
 
 /// One decision of the budget policy, in the query's order.
 struct Decision {
-    allocation: Allocation,
-    /// The creatures searched for contacts with others (by their place in the query, in
-    /// order), and how urgent their soonest contact is.
-    searched: Vec<(usize, f32)>,
+    /// Settled: the creatures searched for contacts with others (by their place in the query,
+    /// in order), and how urgent their soonest contact is.
+    allocation: Allocation<f32>,
 }
 
 impl Decision {
@@ -760,7 +856,6 @@ fn decide(
     if !floors.any_step_fits(room_us) {
         return Decision {
             allocation: floors.allocation(budget_us, config.costs.overhead_us(0)),
-            searched: Vec::new(),
         };
     }
     let rows: Vec<_> = creatures.iter().collect();
@@ -792,16 +887,14 @@ fn decide(
     );
     // Only a creature that could still buy a level is searched for contacts with the others.
     let search_us = config.costs.contact_search_us;
-    let mut searched = Vec::new();
     let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, search_us, |i| {
         let (_, c, _, s, _) = rows[i];
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
-        searched.push((i, urgency));
-        bounds[i].rigid(rules, urgency)
+        (bounds[i].rigid(rules, urgency), urgency)
     });
-    searched.sort_unstable_by_key(|s| s.0);
+    allocation.settled.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
-    Decision { allocation, searched }
+    Decision { allocation }
 }
 
 fn scene<'a>(
@@ -880,7 +973,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     tally.record(&decision.allocation);
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
-    let mut searched = decision.searched.iter().peekable();
+    let mut searched = decision.allocation.settled.iter().peekable();
     for (row, (.., mut choice)) in creatures.iter_mut().enumerate() {
         decision.write(&mut searched, row, now_s, &mut choice);
     }
@@ -889,7 +982,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
 /// The budget policy's choice for the world as it stands, at its rules' budget, without
 /// applying it: what `simlod bench --calibrate` times to measure the choice. None in a world
 /// without the simulation's resources.
-pub fn choice_now(world: &mut World) -> Option<Allocation> {
+pub fn choice_now(world: &mut World) -> Option<Allocation<f32>> {
     let mut state = bevy::ecs::system::SystemState::<(DecisionInputs, Creatures)>::new(world);
     let (inputs, creatures) = state.get_mut(world).ok()?;
     Some(inputs.decide(&creatures, 1.0).allocation)
@@ -910,7 +1003,7 @@ fn start_by_budget(
     }
     let now = inputs.clock.seconds() as f32;
     let decision = inputs.decide(&creatures, tally.correction);
-    let mut searched = decision.searched.iter().peekable();
+    let mut searched = decision.allocation.settled.iter().peekable();
     for (row, ((entity, c, &lod, _, mut choice), &level)) in
         creatures.iter_mut().zip(&decision.allocation.levels).enumerate()
     {
@@ -980,17 +1073,20 @@ mod tests {
         let floors = vec![Lod::PointMass; 3];
         for budget_us in [0.0, 2.0, 3.9] {
             assert!(!floors_of(&crowd).any_step_fits(budget_us));
-            let allocation = allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 0.0, |_| 0.0);
+            let allocation = allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 0.0, |_| (0.0, ()));
             assert_eq!(allocation.levels, floors, "{budget_us} us");
             // The floors gathered alone are that allocation, a frame's fixed cost beside them.
             let fixed_us = 0.5;
-            let by_floors = floors_of(&crowd).allocation(budget_us + fixed_us, fixed_us);
+            let by_floors: Allocation = floors_of(&crowd).allocation(budget_us + fixed_us, fixed_us);
             assert_eq!(by_floors.levels, allocation.levels);
             assert_eq!(by_floors.exceeded, allocation.exceeded, "{budget_us} us");
             assert!((by_floors.predicted_us - (allocation.predicted_us + fixed_us)).abs() < 1e-6);
         }
         assert!(floors_of(&crowd).any_step_fits(4.0));
-        assert_ne!(allocate(&mut crowd.clone(), 4.0, 0.0, 0.0, 0.0, |_| 0.0).levels, floors);
+        assert_ne!(
+            allocate(&mut crowd.clone(), 4.0, 0.0, 0.0, 0.0, |_| (0.0, ())).levels,
+            floors
+        );
         // A rigid creature dwelling at its level: its floor is rigid, its own cost counts.
         let dwelling = Candidate {
             floor: Lod::Rigid,
@@ -1029,7 +1125,7 @@ mod tests {
                     // Unsettled: the most the rigid level could be worth.
                     benefit: [0.0, hybrid, hybrid + 2.0],
                     settled: false,
-                    ..candidate(1000 - i, current, 0.0)
+                    ..candidate(n - i, current, 0.0)
                 }
             })
             .collect();
@@ -1055,23 +1151,63 @@ mod tests {
                 hysteresis,
                 least_per_us,
                 0.0,
-                |_| unreachable!("every benefit is exact"),
+                |_| -> (f32, ()) { unreachable!("every benefit is exact") },
             );
-            let mut asked = Vec::new();
             let lazy = allocate(&mut crowd.clone(), budget_us, hysteresis, least_per_us, 0.0, |i| {
-                asked.push(i);
-                exact[i]
+                (exact[i], i)
             });
             assert_eq!(lazy.levels, whole.levels, "{budget_us} us");
             assert_eq!(lazy.predicted_us, whole.predicted_us);
-            assert_eq!(lazy.settled, asked.len());
-            // Each settled once, and under a small budget only a few.
+            // Each settled once, with what its settling gave, and under a small budget only a few.
+            let mut asked: Vec<usize> = lazy
+                .settled
+                .iter()
+                .map(|&(i, kept)| {
+                    assert_eq!(i, kept);
+                    i
+                })
+                .collect();
             asked.sort_unstable();
             asked.dedup();
-            assert_eq!(asked.len(), lazy.settled);
+            assert_eq!(asked.len(), lazy.settled.len());
             if budget_us < 1000.0 {
-                assert!(lazy.settled < 30, "{} settled", lazy.settled);
+                assert!(lazy.settled.len() < 30, "{} settled", lazy.settled.len());
             }
+        }
+    }
+
+    #[test]
+    fn settling_ahead_across_the_cores_chooses_as_settling_one_at_a_time() {
+        bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
+        // A crowd big enough to be settled ahead in batches.
+        let (crowd, exact) = mixed_crowd(4 * crate::contract::PARALLEL_MIN_CREATURES);
+        let settled_first: Vec<Candidate> = crowd
+            .iter()
+            .zip(&exact)
+            .map(|(c, &rigid)| Candidate {
+                benefit: [0.0, c.benefit[1], rigid],
+                settled: true,
+                ..c.clone()
+            })
+            .collect();
+        for budget_us in [320_000.0, 450_000.0, 1_500_000.0] {
+            let whole = allocate(&mut settled_first.clone(), budget_us, 0.2, 0.0, 0.0, |_| (0.0, ()));
+            let ahead = allocate(&mut crowd.clone(), budget_us, 0.2, 0.0, 0.0, |i| (exact[i], i));
+            assert_eq!(ahead.levels, whole.levels, "{budget_us} us");
+            assert_eq!(ahead.predicted_us, whole.predicted_us);
+            assert!(ahead.settled.iter().all(|&(i, kept)| i == kept));
+            let mut once: Vec<usize> = ahead.settled.iter().map(|s| s.0).collect();
+            once.sort_unstable();
+            once.dedup();
+            assert_eq!(once.len(), ahead.settled.len(), "{budget_us} us");
+            // Charged for its searches, what it settles and chooses stays within the budget.
+            let charged = allocate(&mut crowd.clone(), budget_us, 0.2, 0.0, 3.0, |i| (exact[i], ()));
+            assert!(!charged.settled.is_empty());
+            assert!(
+                charged.predicted_us <= budget_us,
+                "{budget_us} us: {}",
+                charged.predicted_us
+            );
         }
     }
 
@@ -1082,15 +1218,15 @@ mod tests {
         for c in &mut crowd {
             (c.current, c.floor) = (Lod::PointMass, Lod::PointMass);
         }
-        let free = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 0.0, |i| exact[i]);
-        let charged = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 5.0, |i| exact[i]);
-        assert!(charged.settled > 0);
+        let free = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 0.0, |i| (exact[i], ()));
+        let charged = allocate(&mut crowd.clone(), 3000.0, 0.2, 0.0, 5.0, |i| (exact[i], ()));
+        assert!(!charged.settled.is_empty());
         let at_levels: f32 = crowd
             .iter()
             .zip(&charged.levels)
             .map(|(c, &l)| c.frame_cost_us(l))
             .sum();
-        let searched = charged.settled as f32 * 5.0;
+        let searched = charged.settled.len() as f32 * 5.0;
         assert!(
             (charged.predicted_us - (at_levels + searched)).abs() < 0.01,
             "{charged:?}"
@@ -1212,7 +1348,7 @@ mod tests {
     fn the_budget_goes_to_the_most_benefit_per_cost_and_is_never_exceeded() {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Room for two going rigid and three hybrids (2 x (100 + 50) + 3 x 2 = 306).
-        let a = allocate(&mut cs.clone(), 310.0, 0.0, 0.0, 0.0, |_| 0.0);
+        let a = allocate(&mut cs.clone(), 310.0, 0.0, 0.0, 0.0, |_| (0.0, ()));
         assert_eq!(
             a.levels,
             [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid, Lod::Rigid]
@@ -1224,7 +1360,7 @@ mod tests {
     fn a_level_that_gains_less_than_the_least_benefit_per_cost_is_not_bought_however_large_the_budget() {
         let cs: Vec<_> = (0..5).map(|i| candidate(i, Lod::PointMass, i as f32)).collect();
         // Going rigid from hybrid gains i - 0.5 for 148 us; at 0.02 per us only i = 4 pays.
-        let a = allocate(&mut cs.clone(), 10_000.0, 0.0, 0.02, 0.0, |_| 0.0);
+        let a = allocate(&mut cs.clone(), 10_000.0, 0.0, 0.02, 0.0, |_| (0.0, ()));
         assert_eq!(
             a.levels,
             [Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Hybrid, Lod::Rigid]
@@ -1240,7 +1376,7 @@ mod tests {
         // One rigid now, with no benefit left; one hybrid with a contact ahead. Going down in
         // the flight window, the first still costs its rigid level this frame: no room yet.
         let cs = [candidate(0, Lod::Rigid, 0.0), candidate(1, Lod::Hybrid, 5.0)];
-        let a = allocate(&mut cs.clone(), 160.0, 0.0, 0.0, 0.0, |_| 0.0);
+        let a = allocate(&mut cs.clone(), 160.0, 0.0, 0.0, 0.0, |_| (0.0, ()));
         assert_eq!(a.levels, [Lod::Hybrid, Lod::Hybrid]);
         assert!(a.predicted_us <= 160.0, "{a:?}");
     }
@@ -1275,7 +1411,7 @@ mod tests {
     #[test]
     fn too_small_a_budget_gives_the_cheapest_levels_and_says_so() {
         let cs: Vec<_> = (0..3).map(|i| candidate(i, Lod::PointMass, 9.0)).collect();
-        let a = allocate(&mut cs.clone(), 1.0, 0.0, 0.0, 0.0, |_| 0.0);
+        let a = allocate(&mut cs.clone(), 1.0, 0.0, 0.0, 0.0, |_| (0.0, ()));
         assert_eq!(a.levels, [Lod::PointMass; 3]);
         assert!(a.exceeded);
     }

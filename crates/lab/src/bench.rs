@@ -356,7 +356,7 @@ fn choice_cost_us(config: &SimConfig, model: &CostModel, count: u32, warmup: usi
             (0..calls)
                 .map(|_| {
                     let start = Instant::now();
-                    searched = simlod::lod::choice_now(world).map_or(0, |a| a.settled);
+                    searched = simlod::lod::choice_now(world).map_or(0, |a| a.settled.len());
                     start.elapsed().as_secs_f64() * 1e6
                 })
                 .collect(),
