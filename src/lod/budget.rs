@@ -84,8 +84,12 @@ impl Candidate<'_> {
 
     /// The next step up its upper hull of cost and benefit from `at`: the most benefit per
     /// microsecond, ties to the lower level; none below `least_per_us`.
-    /// `settle_us` is what settling a bound costs (see [`Step::need_us`]).
-    fn step_from(&self, creature: u32, at: Lod, hysteresis: f32, least_per_us: f32, settle_us: f32) -> Option<Step> {
+    fn step_from(&self, creature: u32, at: Lod, hull: &Hull) -> Option<Step> {
+        let Hull {
+            hysteresis,
+            least_per_us,
+            ..
+        } = *hull;
         let (cost, value) = (self.cost_us(at), self.value(at, hysteresis));
         self.levels
             .iter()
@@ -105,11 +109,7 @@ impl Candidate<'_> {
                     from: at,
                     to,
                     extra_us,
-                    need_us: if bound {
-                        settle_us + self.cheapest_step_us(at)
-                    } else {
-                        extra_us
-                    },
+                    need_us: if bound { self.cheapest_step_us(at) } else { extra_us },
                 }
             })
             .max_by(|a, b| a.ratio.total_cmp(&b.ratio).then(b.to.cmp(&a.to)))
@@ -118,11 +118,11 @@ impl Candidate<'_> {
 
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
-    fn list_hull(&self, creature: u32, hysteresis: f32, least_per_us: f32, settle_us: f32, listed: &mut Vec<Step>) {
-        let mut next = self.step_from(creature, self.floor, hysteresis, least_per_us, settle_us);
+    fn list_hull(&self, creature: u32, hull: &Hull, listed: &mut Vec<Step>) {
+        let mut next = self.step_from(creature, self.floor, hull);
         while let Some(step) = next {
             listed.push(step);
-            next = self.step_from(creature, step.to, hysteresis, least_per_us, settle_us);
+            next = self.step_from(creature, step.to, hull);
         }
     }
 
@@ -172,7 +172,7 @@ struct Step {
     to: Lod,
     extra_us: f32,
     /// The least room in the budget the step needs to change anything: its extra cost, or
-    /// while a bound, the search that settles it and the cheapest step after.
+    /// while a bound, the cheapest step after the search that settles it (and that search).
     need_us: f32,
 }
 
@@ -235,17 +235,28 @@ pub fn allocate<S: Send>(
     settle_us: f32,
     settle: impl Fn(usize) -> (f32, S) + Sync,
 ) -> Allocation<S> {
-    let mut levels: Vec<Lod> = candidates.iter().map(|c| c.floor).collect();
-    // Whether each is settled, beside the levels: the queue's order is not the creatures', and
-    // a look at a creature for each step that waits in it would miss the cache.
-    let mut settled_now: Vec<bool> = candidates.iter().map(|c| c.settled).collect();
-    let mut spent: f32 = candidates.iter().map(|c| c.cost_us(c.floor)).sum();
-    // Every creature's steps up its hull (two at most), and the cheapest step of all.
+    let hull = Hull {
+        hysteresis,
+        least_per_us,
+        settle_us,
+    };
+    // In one pass over the creatures: each one's floor, whether it is settled (beside the
+    // levels: the queue's order is not the creatures', and a look at a creature for each step
+    // that waits in it would miss the cache), what the floors cost and what the frame as it
+    // will run costs (creatures going down still cost their level: a search is paid for at
+    // once and never given back, so it must fit beside that too), the cheapest step of all,
+    // and every creature's steps up its hull (two at most).
+    let mut levels = Vec::with_capacity(candidates.len());
+    let mut settled_now = Vec::with_capacity(candidates.len());
+    let (mut spent, mut running_us, mut cheapest_us) = (0.0f32, 0.0f32, f32::INFINITY);
     let mut listed = Vec::with_capacity(2 * candidates.len());
-    let mut cheapest_us = f32::INFINITY;
     for (i, c) in candidates.iter().enumerate() {
+        levels.push(c.floor);
+        settled_now.push(c.settled);
+        spent += c.cost_us(c.floor);
+        running_us += c.frame_cost_us(c.floor);
         cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us());
-        c.list_hull(i as u32, hysteresis, least_per_us, settle_us, &mut listed);
+        c.list_hull(i as u32, &hull, &mut listed);
     }
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
@@ -261,21 +272,20 @@ pub fn allocate<S: Send>(
         need_from[i] = need_from[i + 1].min(step.need_us);
     }
     let mut next = 0;
-    let mut follows = std::collections::BinaryHeap::new();
+    let mut follows = Follows::default();
     let mut ahead = SettledAhead::new(threads_for(candidates.len() as u32));
     let (mut taken, mut settled) = (Vec::new(), Vec::new());
-    // The frame as it will run (creatures going down still cost their level): a search is
-    // paid for at once and never given back, so it must fit beside that too.
-    let mut running_us: f32 = candidates.iter().map(|c| c.frame_cost_us(c.floor)).sum();
     loop {
         let first = listed.get(next).filter(|_| spent + need_from[next] <= budget_us);
-        let (step, followed) = match (first, follows.peek()) {
-            (Some(first), Some(follow)) if follow > first => (follows.pop(), true),
+        let (step, followed) = match (first, follows.heap.peek()) {
+            (Some(first), Some(follow)) if follow > first => (follows.heap.pop(), true),
             (Some(&first), _) => {
                 next += 1;
                 (Some(first), false)
             }
-            (None, _) => (follows.pop(), true),
+            // Once none of them fits, the steps waiting in the heap are passed by too.
+            (None, _) if spent + follows.need_us <= budget_us => (follows.heap.pop(), true),
+            (None, _) => (None, true),
         };
         let Some(step) = step else { break };
         if spent + cheapest_us > budget_us {
@@ -287,29 +297,30 @@ pub fn allocate<S: Send>(
         if levels[creature] != step.from || (step.bound && settled_now[creature]) {
             continue;
         }
-        let c = &mut candidates[creature];
         if step.bound {
-            // Worth settling only with room for the search and a step after it.
+            // Worth settling only with room for the search and a step after it (its need).
             let paid_for = settle_us == 0.0 || running_us + settle_us <= budget_us;
-            if paid_for && spent + settle_us + c.cheapest_step_us(step.from) <= budget_us {
+            if paid_for && spent + settle_us + step.need_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
-                let (benefit, kept) = ahead.take(next - 1, &listed, &settled_now, room_us, settle_us, &settle);
+                let now = ahead.take(next - 1, &listed, candidates, &settled_now, &hull, room_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
-                settled.push((creature, kept));
-                c.benefit[Lod::Rigid as usize] = benefit;
+                settled.push((creature, now.kept));
+                let c = &mut candidates[creature];
+                c.benefit[Lod::Rigid as usize] = now.benefit;
                 (c.settled, settled_now[creature]) = (true, true);
-                follows.extend(c.step_from(step.creature, step.from, hysteresis, least_per_us, settle_us));
+                follows.push(now.step);
             }
         } else if spent + step.extra_us <= budget_us {
+            let c = &candidates[creature];
             levels[creature] = step.to;
             spent += step.extra_us;
             running_us += c.frame_cost_us(step.to) - c.frame_cost_us(step.from);
             taken.push(step);
             // A listed step's successor is listed too.
             if followed {
-                follows.extend(c.step_from(step.creature, step.to, hysteresis, least_per_us, settle_us));
+                follows.push(c.step_from(step.creature, step.to, &hull));
             }
         }
     }
@@ -345,13 +356,57 @@ pub fn allocate<S: Send>(
     }
 }
 
+/// The steps of settled creatures, waiting beside the list, and the least any of them ever
+/// needed (what is left needs no less).
+struct Follows {
+    heap: std::collections::BinaryHeap<Step>,
+    need_us: f32,
+}
+
+impl Default for Follows {
+    fn default() -> Self {
+        Self {
+            heap: Default::default(),
+            need_us: f32::INFINITY,
+        }
+    }
+}
+
+impl Follows {
+    fn push(&mut self, step: Option<Step>) {
+        if let Some(step) = step {
+            self.need_us = self.need_us.min(step.need_us);
+            self.heap.push(step);
+        }
+    }
+}
+
+/// What the knapsack's steps are worked out with: a creature's last level counts `hysteresis`
+/// more; a step gaining less than `least_per_us` is not listed; settling a bound costs
+/// `settle_us`.
+#[derive(Clone, Copy, Debug)]
+struct Hull {
+    hysteresis: f32,
+    least_per_us: f32,
+    settle_us: f32,
+}
+
+/// A bound settled: the exact benefit, what the caller keeps of the settling, and the
+/// creature's step from there.
+struct Settled<S> {
+    benefit: f32,
+    kept: S,
+    step: Option<Step>,
+}
+
 /// The bounds further down the queue, settled ahead across the cores: by their place in the
-/// list, in order.
+/// list, in order. Each is settled and its next step worked out beside its creature, so the
+/// queue's loop does not wait on a creature it has not looked at for a while.
 struct SettledAhead<S> {
     threads: usize,
     /// How many bounds the next batch looks ahead for at most (it doubles with each batch).
     batch: usize,
-    settled: std::collections::VecDeque<(usize, (f32, S))>,
+    settled: std::collections::VecDeque<(usize, Settled<S>)>,
 }
 
 impl<S: Send> SettledAhead<S> {
@@ -363,24 +418,26 @@ impl<S: Send> SettledAhead<S> {
         }
     }
 
-    /// What settling the bound listed at `at` gives: made ahead, or made now together with the
-    /// next unsettled bounds in the list, no more than `room_us` could pay for at `settle_us`
-    /// each (on one thread, it alone).
+    /// The bound listed at `at`, settled: made ahead, or made now together with the next
+    /// unsettled bounds in the list, no more than `room_us` could pay for (on one thread, it
+    /// alone).
+    #[allow(clippy::too_many_arguments)]
     fn take(
         &mut self,
         at: usize,
         listed: &[Step],
+        candidates: &[Candidate],
         settled_now: &[bool],
+        hull: &Hull,
         room_us: f32,
-        settle_us: f32,
         settle: &(impl Fn(usize) -> (f32, S) + Sync),
-    ) -> (f32, S) {
+    ) -> Settled<S> {
         while self.settled.front().is_some_and(|s| s.0 < at) {
             self.settled.pop_front();
         }
         if self.settled.front().is_none_or(|s| s.0 != at) {
-            let affordable = if settle_us > 0.0 {
-                (room_us / settle_us) as usize
+            let affordable = if hull.settle_us > 0.0 {
+                (room_us / hull.settle_us) as usize
             } else {
                 usize::MAX
             };
@@ -394,12 +451,18 @@ impl<S: Send> SettledAhead<S> {
                 .filter(|&i| listed[i].bound && !settled_now[listed[i].creature as usize])
                 .take(most)
                 .collect();
-            let mut made: Vec<Option<(f32, S)>> = places.iter().map(|_| None).collect();
+            let mut made: Vec<Option<Settled<S>>> = places.iter().map(|_| None).collect();
             let n = places.len().div_ceil(self.threads);
             run_chunks(places.chunks(n).zip(made.chunks_mut(n)).map(|(places, made)| {
                 move || {
                     for (&i, m) in places.iter().zip(made) {
-                        *m = Some(settle(listed[i].creature as usize));
+                        let step = &listed[i];
+                        let (benefit, kept) = settle(step.creature as usize);
+                        let mut c = candidates[step.creature as usize].clone();
+                        c.benefit[Lod::Rigid as usize] = benefit;
+                        c.settled = true;
+                        let step = c.step_from(step.creature, step.from, hull);
+                        *m = Some(Settled { benefit, kept, step });
                     }
                 }
             }));
