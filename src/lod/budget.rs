@@ -108,8 +108,8 @@ impl Candidate<'_> {
                     creature,
                     from: at,
                     to,
-                    extra_us,
-                    need_us: if bound { self.cheapest_step_us(at) } else { extra_us },
+                    extra_us: if bound { self.cheapest_step_us(at) } else { extra_us },
+                    running_us: self.frame_cost_us(to) - self.frame_cost_us(at),
                 }
             })
             .max_by(|a, b| a.ratio.total_cmp(&b.ratio).then(b.to.cmp(&a.to)))
@@ -170,10 +170,13 @@ struct Step {
     creature: u32,
     from: Lod,
     to: Lod,
+    /// What the step adds to the predicted frame: the least room in the budget it needs to
+    /// change anything. While a bound, the least a step after the search that settles it adds
+    /// (the search beside).
     extra_us: f32,
-    /// The least room in the budget the step needs to change anything: its extra cost, or
-    /// while a bound, the cheapest step after the search that settles it (and that search).
-    need_us: f32,
+    /// What the step adds to the frame as it will run (a creature going down still costs its
+    /// level): kept, so that taking the step does not look at its creature again.
+    running_us: f32,
 }
 
 /// The order steps are taken in, greatest first: the most benefit per microsecond, then the
@@ -265,18 +268,25 @@ pub fn allocate<S: Send>(
     } else {
         listed.clear();
     }
-    // The least room any listed step from each on needs: once the budget has less, the rest of
-    // the list can change nothing and is passed by.
-    let mut need_from = vec![f32::INFINITY; listed.len() + 1];
+    // The least room any listed step from each on needs, and any exact one: once the budget
+    // has less (or no search fits beside the frame as it will run, which only grows), the rest
+    // of the list can change nothing and is passed by.
+    let mut need_from = vec![(f32::INFINITY, f32::INFINITY); listed.len() + 1];
     for (i, step) in listed.iter().enumerate().rev() {
-        need_from[i] = need_from[i + 1].min(step.need_us);
+        let (any, exact) = need_from[i + 1];
+        let exact_need = if step.bound { f32::INFINITY } else { step.extra_us };
+        need_from[i] = (any.min(step.extra_us), exact.min(exact_need));
     }
     let mut next = 0;
     let mut follows = Follows::default();
     let mut ahead = SettledAhead::new(threads_for(candidates.len() as u32));
     let (mut taken, mut settled) = (Vec::new(), Vec::new());
     loop {
-        let first = listed.get(next).filter(|_| spent + need_from[next] <= budget_us);
+        let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
+        let first = listed.get(next).filter(|_| {
+            let (any, exact) = need_from[next];
+            spent + if searches_fit { any } else { exact } <= budget_us
+        });
         let (step, followed) = match (first, follows.heap.peek()) {
             (Some(first), Some(follow)) if follow > first => (follows.heap.pop(), true),
             (Some(&first), _) => {
@@ -284,7 +294,7 @@ pub fn allocate<S: Send>(
                 (Some(first), false)
             }
             // Once none of them fits, the steps waiting in the heap are passed by too.
-            (None, _) if spent + follows.need_us <= budget_us => (follows.heap.pop(), true),
+            (None, _) if spent + follows.extra_us <= budget_us => (follows.heap.pop(), true),
             (None, _) => (None, true),
         };
         let Some(step) = step else { break };
@@ -298,9 +308,8 @@ pub fn allocate<S: Send>(
             continue;
         }
         if step.bound {
-            // Worth settling only with room for the search and a step after it (its need).
-            let paid_for = settle_us == 0.0 || running_us + settle_us <= budget_us;
-            if paid_for && spent + settle_us + step.need_us <= budget_us {
+            // Worth settling only with room for the search and a step after it.
+            if searches_fit && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
                 let now = ahead.take(next - 1, &listed, candidates, &settled_now, &hull, room_us, &settle);
@@ -313,14 +322,13 @@ pub fn allocate<S: Send>(
                 follows.push(now.step);
             }
         } else if spent + step.extra_us <= budget_us {
-            let c = &candidates[creature];
             levels[creature] = step.to;
             spent += step.extra_us;
-            running_us += c.frame_cost_us(step.to) - c.frame_cost_us(step.from);
+            running_us += step.running_us;
             taken.push(step);
             // A listed step's successor is listed too.
             if followed {
-                follows.push(c.step_from(step.creature, step.to, &hull));
+                follows.push(candidates[creature].step_from(step.creature, step.to, &hull));
             }
         }
     }
@@ -339,9 +347,8 @@ pub fn allocate<S: Send>(
         if predicted_us <= budget_us {
             break;
         }
-        let c = &candidates[step.creature as usize];
         levels[step.creature as usize] = step.from;
-        predicted_us += c.frame_cost_us(step.from) - c.frame_cost_us(step.to);
+        predicted_us -= step.running_us;
         given_back = true;
     }
     // Summed afresh once, so that the steps' rounding does not add up.
@@ -360,14 +367,14 @@ pub fn allocate<S: Send>(
 /// needed (what is left needs no less).
 struct Follows {
     heap: std::collections::BinaryHeap<Step>,
-    need_us: f32,
+    extra_us: f32,
 }
 
 impl Default for Follows {
     fn default() -> Self {
         Self {
             heap: Default::default(),
-            need_us: f32::INFINITY,
+            extra_us: f32::INFINITY,
         }
     }
 }
@@ -375,7 +382,7 @@ impl Default for Follows {
 impl Follows {
     fn push(&mut self, step: Option<Step>) {
         if let Some(step) = step {
-            self.need_us = self.need_us.min(step.need_us);
+            self.extra_us = self.extra_us.min(step.extra_us);
             self.heap.push(step);
         }
     }
@@ -669,6 +676,13 @@ pub fn time_to_contact(d: Vec2, w: Vec2, reach: f32) -> f32 {
     (-b - disc.sqrt()) / (2.0 * a)
 }
 
+/// `e^x`, without the library's slow path for a result that underflows to 0 (most creatures
+/// of a crowd are that far from any contact): below -104 it is 0 (under half the least
+/// subnormal), as the library would round it.
+fn decay(x: f32) -> f32 {
+    if x < -104.0 { 0.0 } else { x.exp() }
+}
+
 /// The first ring of the search for the soonest contact with another creature, m.
 const NEAREST_RING_M: f32 = 4.0;
 
@@ -692,9 +706,7 @@ impl Scene<'_> {
     /// earliest `t_worst` away, is worth.
     fn urgency(&self, t_course: f32, t_worst: f32) -> f32 {
         let h = self.rules.contact_horizon_s;
-        (-t_course / h)
-            .exp()
-            .max(self.rules.worst_case_share * (-t_worst / h).exp())
+        decay(-t_course / h).max(self.rules.worst_case_share * decay(-t_worst / h))
     }
 
     /// How urgent a contact is with a circle of `circle_radius` at `centre` moving at `velocity`.
@@ -1389,6 +1401,28 @@ mod tests {
             with_neighbours += usize::from(seen > 0);
         }
         assert!(with_neighbours > 2800);
+    }
+
+    #[test]
+    fn decay_is_the_exponential_down_to_where_it_rounds_to_zero() {
+        for x in [
+            0.0f32,
+            -1.0,
+            -50.0,
+            -87.0,
+            -100.0,
+            -103.9,
+            -104.0,
+            -104.1,
+            -200.0,
+            f32::NEG_INFINITY,
+        ] {
+            assert_eq!(decay(x).to_bits(), x.exp().to_bits(), "{x}");
+        }
+        // Every float from -104 to -128 (a negative float's bits grow as it falls).
+        for bits in (-104.0f32).to_bits()..=(-128.0f32).to_bits() {
+            assert_eq!(f32::from_bits(bits).exp(), 0.0);
+        }
     }
 
     #[test]
