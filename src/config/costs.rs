@@ -84,6 +84,12 @@ impl LevelCosts {
         }
     }
 
+    /// Whether each level costs no less than the one below (a crowd's shares can make a
+    /// hybrid cheaper than a point mass).
+    pub fn rise_with_level(&self) -> bool {
+        self.point_mass_us_per_frame <= self.hybrid_us_per_frame && self.hybrid_us_per_frame <= self.rigid_us_per_frame
+    }
+
     /// The most any cost may be, in microseconds.
     const MOST_US: f32 = 1_000_000.0;
 

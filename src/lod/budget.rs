@@ -253,7 +253,11 @@ pub fn allocate<S: Send>(
     let mut settled_now = Vec::with_capacity(candidates.len());
     let (mut spent, mut running_us, mut cheapest_us) = (0.0f32, 0.0f32, f32::INFINITY);
     let mut listed = Vec::with_capacity(2 * candidates.len());
+    // Where every level costs no less than the one below, what is spent and the frame as it
+    // will run only grow, so a step that cannot fit now never will and may be passed by.
+    let mut rising = true;
     for (i, c) in candidates.iter().enumerate() {
+        rising &= c.costs.rise_with_level();
         levels.push(c.floor);
         settled_now.push(c.settled);
         spent += c.cost_us(c.floor);
@@ -285,7 +289,7 @@ pub fn allocate<S: Send>(
         let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
         let first = listed.get(next).filter(|_| {
             let (any, exact) = need_from[next];
-            spent + if searches_fit { any } else { exact } <= budget_us
+            !rising || spent + if searches_fit { any } else { exact } <= budget_us
         });
         let (step, followed) = match (first, follows.heap.peek()) {
             (Some(first), Some(follow)) if follow > first => (follows.heap.pop(), true),
@@ -294,7 +298,7 @@ pub fn allocate<S: Send>(
                 (Some(first), false)
             }
             // Once none of them fits, the steps waiting in the heap are passed by too.
-            (None, _) if spent + follows.extra_us <= budget_us => (follows.heap.pop(), true),
+            (None, _) if !rising || spent + follows.extra_us <= budget_us => (follows.heap.pop(), true),
             (None, _) => (None, true),
         };
         let Some(step) = step else { break };
@@ -1207,18 +1211,40 @@ mod tests {
         (crowd, exact)
     }
 
-    #[test]
-    fn settling_only_the_creatures_that_reach_the_front_chooses_as_settling_them_all() {
-        let (crowd, exact) = mixed_crowd(300);
-        let settled_first: Vec<Candidate> = crowd
+    /// The crowd with every rigid benefit exact from the start.
+    fn settled_first(crowd: &[Candidate<'static>], exact: &[f32]) -> Vec<Candidate<'static>> {
+        crowd
             .iter()
-            .zip(&exact)
+            .zip(exact)
             .map(|(c, &rigid)| Candidate {
                 benefit: [0.0, c.benefit[1], rigid],
                 settled: true,
                 ..c.clone()
             })
+            .collect()
+    }
+
+    /// Checks that each creature was settled once, with what its own settling gave (its
+    /// index), and returns how many were.
+    fn settled_once_each(a: &Allocation<usize>) -> usize {
+        let mut once: Vec<usize> = a
+            .settled
+            .iter()
+            .map(|&(i, kept)| {
+                assert_eq!(i, kept);
+                i
+            })
             .collect();
+        once.sort_unstable();
+        once.dedup();
+        assert_eq!(once.len(), a.settled.len());
+        once.len()
+    }
+
+    #[test]
+    fn settling_only_the_creatures_that_reach_the_front_chooses_as_settling_them_all() {
+        let (crowd, exact) = mixed_crowd(300);
+        let settled_first = settled_first(&crowd, &exact);
         for (budget_us, hysteresis, least_per_us) in [(800.0, 0.0, 0.0), (3000.0, 0.2, 0.0), (20_000.0, 0.2, 0.005)] {
             let whole = allocate(
                 &mut settled_first.clone(),
@@ -1233,20 +1259,10 @@ mod tests {
             });
             assert_eq!(lazy.levels, whole.levels, "{budget_us} us");
             assert_eq!(lazy.predicted_us, whole.predicted_us);
-            // Each settled once, with what its settling gave, and under a small budget only a few.
-            let mut asked: Vec<usize> = lazy
-                .settled
-                .iter()
-                .map(|&(i, kept)| {
-                    assert_eq!(i, kept);
-                    i
-                })
-                .collect();
-            asked.sort_unstable();
-            asked.dedup();
-            assert_eq!(asked.len(), lazy.settled.len());
+            // Each settled once, and under a small budget only a few.
+            let settled = settled_once_each(&lazy);
             if budget_us < 1000.0 {
-                assert!(lazy.settled.len() < 30, "{} settled", lazy.settled.len());
+                assert!(settled < 30, "{settled} settled");
             }
         }
     }
@@ -1256,25 +1272,13 @@ mod tests {
         bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
         // A crowd big enough to be settled ahead in batches.
         let (crowd, exact) = mixed_crowd(4 * crate::contract::PARALLEL_MIN_CREATURES);
-        let settled_first: Vec<Candidate> = crowd
-            .iter()
-            .zip(&exact)
-            .map(|(c, &rigid)| Candidate {
-                benefit: [0.0, c.benefit[1], rigid],
-                settled: true,
-                ..c.clone()
-            })
-            .collect();
+        let settled_first = settled_first(&crowd, &exact);
         for budget_us in [320_000.0, 450_000.0, 1_500_000.0] {
             let whole = allocate(&mut settled_first.clone(), budget_us, 0.2, 0.0, 0.0, |_| (0.0, ()));
             let ahead = allocate(&mut crowd.clone(), budget_us, 0.2, 0.0, 0.0, |i| (exact[i], i));
             assert_eq!(ahead.levels, whole.levels, "{budget_us} us");
             assert_eq!(ahead.predicted_us, whole.predicted_us);
-            assert!(ahead.settled.iter().all(|&(i, kept)| i == kept));
-            let mut once: Vec<usize> = ahead.settled.iter().map(|s| s.0).collect();
-            once.sort_unstable();
-            once.dedup();
-            assert_eq!(once.len(), ahead.settled.len(), "{budget_us} us");
+            settled_once_each(&ahead);
             // Charged for its searches, what it settles and chooses stays within the budget.
             let charged = allocate(&mut crowd.clone(), budget_us, 0.2, 0.0, 3.0, |i| (exact[i], ()));
             assert!(!charged.settled.is_empty());
@@ -1284,6 +1288,32 @@ mod tests {
                 charged.predicted_us
             );
         }
+    }
+
+    #[test]
+    fn where_a_level_costs_less_than_the_one_below_no_step_is_passed_by() {
+        // Rigid dearer than a point mass, cheaper than a hybrid. The second creature's search
+        // does not fit beside the frame as it will run at its turn; the first, a hybrid bought
+        // rigid after its own search, then makes that frame cheaper. A step passed by at its
+        // turn is not looked at again, so the second is not searched.
+        let costs = LevelCosts {
+            point_mass_us_per_frame: 1.0,
+            hybrid_us_per_frame: 50.0,
+            rigid_us_per_frame: 10.0,
+            switch_to_rigid_us: 0.0,
+        };
+        assert!(!costs.rise_with_level() && COSTS.rise_with_level());
+        let unsettled = |serial, current, rigid| Candidate {
+            costs,
+            benefit: [0.0, 0.0, rigid],
+            settled: false,
+            ..candidate(serial, current, rigid)
+        };
+        let mut crowd = [unsettled(0, Lod::Hybrid, 3.0), unsettled(1, Lod::PointMass, 2.0)];
+        let a = allocate(&mut crowd, 65.0, 0.0, 0.0, 10.0, |_| (1.0, ()));
+        assert_eq!(a.levels, [Lod::Rigid, Lod::PointMass]);
+        assert_eq!(a.settled.len(), 1);
+        assert_eq!(a.predicted_us, 21.0);
     }
 
     #[test]
