@@ -848,14 +848,10 @@ type Creatures<'w, 's> = Query<
     ),
 >;
 
-/// One decision of the budget policy, in the query's order.
-struct Decision {
-    /// Settled: the creatures searched for contacts with others (by their place in the query,
-    /// in order), and how urgent their soonest contact is.
-    allocation: Allocation<f32>,
-}
-
-impl Decision {
+/// One decision of the budget policy, in the query's order: settled are the creatures searched
+/// for contacts with others (by their place in the query, in order), and how urgent their
+/// soonest contact is.
+impl Allocation<f32> {
     /// Keeps a creature's search for `contact_recheck_s`: its choice's new level, and its
     /// search if it had one.
     fn write(
@@ -865,7 +861,7 @@ impl Decision {
         now_s: f32,
         choice: &mut Mut<LevelChoice>,
     ) {
-        let level = self.allocation.levels[row];
+        let level = self.levels[row];
         if choice.wanted != level {
             choice.wanted = level;
         }
@@ -883,7 +879,7 @@ fn decide(
     scene: &Scene,
     creatures: &Creatures,
     budget_us: f32,
-) -> Decision {
+) -> Allocation<f32> {
     let costs = config.costs_by_kind();
     let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
@@ -933,9 +929,7 @@ fn decide(
     // crowd far over its budget). The frame is over the budget only if it is without the
     // choice's charge.
     if !floors.any_step_fits(room_us) {
-        return Decision {
-            allocation: floors.allocation(budget_us, config.costs.overhead_us(0)),
-        };
+        return floors.allocation(budget_us, config.costs.overhead_us(0));
     }
     let rows: Vec<_> = creatures.iter().collect();
     let mut candidates: Vec<Candidate> = rows
@@ -973,7 +967,7 @@ fn decide(
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
-    Decision { allocation }
+    allocation
 }
 
 fn scene<'a>(
@@ -1004,7 +998,7 @@ fn scene<'a>(
 impl DecisionInputs<'_, '_> {
     /// The allocation for every creature now, in the query's order: within the budget as the
     /// cost model predicts it, times `correction`.
-    fn decide(&self, creatures: &Creatures, correction: f32) -> Decision {
+    fn decide(&self, creatures: &Creatures, correction: f32) -> Allocation<f32> {
         let budget_us = self.config.rules.budget.frame_budget_ms * 1e3 / correction;
         let scene = scene(
             &self.config,
@@ -1049,10 +1043,10 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
         );
     }
     let decision = inputs.decide(&creatures, tally.correction);
-    tally.record(&decision.allocation);
+    tally.record(&decision);
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
-    let mut searched = decision.allocation.settled.iter().peekable();
+    let mut searched = decision.settled.iter().peekable();
     for (row, (.., mut choice)) in creatures.iter_mut().enumerate() {
         decision.write(&mut searched, row, now_s, &mut choice);
     }
@@ -1064,7 +1058,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
 pub fn choice_now(world: &mut World) -> Option<Allocation<f32>> {
     let mut state = bevy::ecs::system::SystemState::<(DecisionInputs, Creatures)>::new(world);
     let (inputs, creatures) = state.get_mut(world).ok()?;
-    Some(inputs.decide(&creatures, 1.0).allocation)
+    Some(inputs.decide(&creatures, 1.0))
 }
 
 /// A new world under the budget policy: its creatures, placed at the cheapest level, start at
@@ -1082,10 +1076,8 @@ fn start_by_budget(
     }
     let now = inputs.clock.seconds() as f32;
     let decision = inputs.decide(&creatures, tally.correction);
-    let mut searched = decision.allocation.settled.iter().peekable();
-    for (row, ((entity, c, &lod, _, mut choice), &level)) in
-        creatures.iter_mut().zip(&decision.allocation.levels).enumerate()
-    {
+    let mut searched = decision.settled.iter().peekable();
+    for (row, ((entity, c, &lod, _, mut choice), &level)) in creatures.iter_mut().zip(&decision.levels).enumerate() {
         if level != lod
             && let Ok((mut gait, mut pose)) = gaits.get_mut(entity)
         {
