@@ -46,6 +46,11 @@ pub struct FrameBudgetInGame {
     /// corrects the cost model by its measured frames, smoothed over this many; 0 leaves it
     /// off. 0 to 10,000 frames.
     pub adaptive_frames: f32,
+    /// Whether the game measures the cost model on the machine that plays before its window
+    /// opens (a second or two), in place of the file's, for the whole session. A file without
+    /// it leaves the file's model.
+    #[serde(default)]
+    pub calibrate_at_start: bool,
 }
 
 impl FrameBudgetInGame {

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 use crate::support::*;
 use simlod::SimPlugin;
 use simlod::arena::PuckState;
-use simlod::config::{GameConfig, SimConfig, load_file};
+use simlod::config::{CostModel, GameConfig, SimConfig, load_file};
 use simlod::creature::PlanarState;
 use simlod::headless::HeadlessSim;
 use simlod::lod::LevelPolicy;
@@ -74,14 +74,22 @@ fn the_player_steers_and_a_fall_ends_the_round_until_a_new_one_starts() {
 
 /// The game's rules and hot reload on a copy of the assets, without a window.
 fn watching_app(root: &Path) -> App {
-    watching_app_overriding(root, |_| {})
+    watching_app_overriding(root, |_| {}, None)
 }
 
-/// As [`watching_app`], with the command line's overrides made by `overrides`.
-fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) -> App {
+/// As [`watching_app`], with the command line's overrides made by `overrides`, and playing by
+/// `measured_costs` as if measured at start-up.
+fn watching_app_overriding(
+    root: &Path,
+    overrides: impl FnOnce(&mut SimConfig),
+    measured_costs: Option<CostModel>,
+) -> App {
     let mut config = SimConfig::load(&root.join("scenarios/default.ron"), root).unwrap();
     let file_rules = config.rules.clone();
     overrides(&mut config);
+    if let Some(model) = &measured_costs {
+        config.costs = model.clone();
+    }
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
@@ -96,6 +104,7 @@ fn watching_app_overriding(root: &Path, overrides: impl FnOnce(&mut SimConfig)) 
         "scenarios/default.ron".to_owned(),
         root.to_path_buf(),
         file_rules,
+        measured_costs,
     ))
     .insert_resource(TimeUpdateStrategy::FixedTimesteps(8));
     simlod_game::player::plugin(&mut app);
@@ -179,7 +188,7 @@ fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restar
 #[test]
 fn a_frame_budget_given_at_start_outlives_the_first_loads_and_yields_to_an_edit_of_the_rules() {
     let root = copy_assets("frame_budget_override");
-    let mut app = watching_app_overriding(&root, |c| c.rules.budget.frame_budget_ms = 0.7);
+    let mut app = watching_app_overriding(&root, |c| c.rules.budget.frame_budget_ms = 0.7, None);
     let budget = |app: &mut App| app.world().resource::<SimConfig>().rules.budget.frame_budget_ms;
     for _ in 0..50 {
         app.update();
@@ -472,4 +481,62 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
     });
     assert_eq!(adaptive(&mut app), [12.0; 2]);
+}
+
+#[test]
+fn the_costs_measured_at_start_up_stand_through_edits_of_the_rules_and_of_the_scenario() {
+    let root = copy_assets("game_measured_costs");
+    let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
+    assert!(looks.frame_budget.calibrate_at_start, "as shipped");
+    // A model unlike the file's: every rigid creature twice as dear.
+    let mut measured: CostModel = load_file(&root.join("costs.ron")).unwrap();
+    for k in &mut measured.kinds {
+        k.costs.rigid_us_per_frame *= 2.0;
+    }
+    let mut app = watching_app_overriding(&root, |_| {}, Some(measured.clone()));
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let costs = |app: &mut App| {
+        [
+            app.world().resource::<SimConfig>(),
+            &app.world().resource::<BaseConfig>().0,
+        ]
+        .map(|c| c.costs.clone())
+    };
+    assert_eq!(costs(&mut app), [measured.clone(), measured.clone()]);
+    // The rules edited: they apply, the measured model stays.
+    edit(&root.join("rules/levels.ron"), "min_dwell_s: 0.5", "min_dwell_s: 0.4");
+    update_until(&mut app, "the rules edit", |app| {
+        app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
+    });
+    assert_eq!(costs(&mut app), [measured.clone(), measured.clone()]);
+    // The scenario edited: a new round, by the measured model still.
+    edit(&root.join("scenarios/default.ron"), "seed: 7,", "seed: 8,");
+    update_until(&mut app, "the new round", |app| {
+        app.world().resource::<Round>().number == 1
+    });
+    assert_eq!(app.world().resource::<BaseConfig>().scenario.seed, 8);
+    assert_eq!(costs(&mut app), [measured.clone(), measured]);
+}
+
+#[test]
+fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares() {
+    let config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
+    let measured = simlod_lab::bench::calibrate(&config, simlod_lab::bench::Calibration::AtStartUp);
+    // Every kind of the scenario, a rigid creature far dearer than a hybrid one; the court
+    // and the puck cost something whatever the creatures, and so does the choice.
+    let kinds: Vec<&str> = measured.kinds.iter().map(|k| k.kind.as_str()).collect();
+    assert_eq!(kinds, ["hopper", "biped"]);
+    for k in &measured.kinds {
+        assert!(k.costs.rigid_us_per_frame > 10.0 * k.costs.hybrid_us_per_frame, "{k:?}");
+    }
+    assert!(
+        measured.fixed_us_per_frame > 0.0 && measured.decision_us_per_creature > 0.0,
+        "{measured:?}"
+    );
+    // A crowd of tens of thousands is not measured at start-up: its shares are the file's.
+    assert!(config.costs.crowd_shares.is_some());
+    assert_eq!(measured.crowd_shares, config.costs.crowd_shares);
 }

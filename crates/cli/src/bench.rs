@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use crate::scenario::*;
 use simlod::config::{MeasuredAnew, SimConfig};
 use simlod::lod::Lod;
+use simlod_lab::bench::Calibration;
 
 #[derive(Args)]
 pub(crate) struct BenchArgs {
@@ -61,7 +62,12 @@ impl BenchArgs {
             .out
             .clone()
             .unwrap_or_else(|| self.scenario.assets.join(&config.rules.budget.cost_model));
-        let model = simlod_lab::bench::calibrate(config, self.quick);
+        let how = if self.quick {
+            Calibration::Quick
+        } else {
+            Calibration::Full
+        };
+        let model = simlod_lab::bench::calibrate(config, how);
         let rules = self
             .scenario
             .rules
@@ -85,26 +91,8 @@ impl BenchArgs {
                 "wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):",
                 out.display()
             );
-            for k in &model.kinds {
-                let c = &k.costs;
-                println!(
-                    "  {:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
-                    k.kind,
-                    c.point_mass_us_per_frame,
-                    c.hybrid_us_per_frame,
-                    c.rigid_us_per_frame,
-                    c.switch_to_rigid_us
-                );
-            }
-            println!(
-                "  a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
-                model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
-            );
-            if let Some(shares) = model.crowd_shares {
-                println!(
-                    "  in a crowd (across the cores): point mass x {:.2}, hybrid x {:.2}",
-                    shares.point_mass, shares.hybrid
-                );
+            for line in simlod_lab::bench::cost_model_lines(&model) {
+                println!("  {line}");
             }
         }
         Ok(())

@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 
 pub use capture::{Capture, CapturePlan};
 use simlod::SimPlugin;
-use simlod::config::{ConfigError, GameConfig, Overrides, SimConfig, load_file};
+use simlod::config::{ConfigError, CostModel, GameConfig, Overrides, SimConfig, load_file};
 
 /// What `simlod play` was asked for.
 pub struct PlayOptions {
@@ -80,11 +80,20 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
         )));
     }
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
+    let measured_costs = looks.frame_budget.calibrate_at_start.then(|| measure_costs(&config));
+    if let Some(model) = &measured_costs {
+        config.costs = model.clone();
+    }
     let mut app = App::new();
     add_window_plugins(&mut app, &options)?;
     app.add_plugins(SimPlugin::new(config))
         .insert_resource(GameSettings(looks))
-        .insert_resource(reload::Watched::new(scenario_asset, options.assets.clone(), file_rules));
+        .insert_resource(reload::Watched::new(
+            scenario_asset,
+            options.assets.clone(),
+            file_rules,
+            measured_costs,
+        ));
     plugin(&mut app);
     if let Some(plan) = options.capture {
         capture::plugin(&mut app, plan);
@@ -93,6 +102,24 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
         AppExit::Success => Ok(()),
         AppExit::Error(_) => Err(GameError::Stopped),
     }
+}
+
+/// The budget policy's cost model measured on this machine, said on the terminal: a model
+/// measured on another machine, or on another day, is off by as much as the machines differ.
+fn measure_costs(config: &SimConfig) -> CostModel {
+    eprintln!(
+        "measuring the budget policy's costs on this machine (frame_budget.calibrate_at_start in {GAME_FILE})..."
+    );
+    let start = std::time::Instant::now();
+    let model = simlod_lab::bench::calibrate(config, simlod_lab::bench::Calibration::AtStartUp);
+    eprintln!(
+        "measured in {:.1} s (us per creature per 1/30 s):",
+        start.elapsed().as_secs_f32()
+    );
+    for line in simlod_lab::bench::cost_model_lines(&model) {
+        eprintln!("  {line}");
+    }
+    model
 }
 
 /// The scenario's path inside the assets folder, which is what the asset server watches.

@@ -13,8 +13,8 @@ use std::path::PathBuf;
 use super::player::{BaseConfig, NewRound};
 use super::{GAME_FILE, GameSettings};
 use simlod::config::{
-    ArenaConfig, ConfigError, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file, kind_file,
-    load_costs, resolve_reference,
+    ArenaConfig, ConfigError, CostModel, CreatureDef, GameConfig, LevelRules, Scenario, SimConfig, creature_file,
+    kind_file, load_costs, resolve_reference,
 };
 use simlod::gait::GaitTable;
 
@@ -36,12 +36,20 @@ pub struct Watched {
     /// The level rules as the files last said: the player's radii and frame budget (the keys,
     /// `--frame-budget`) stand until they change.
     file_rules: Option<LevelRules>,
+    /// The cost model measured at start-up: it stands for the session, in place of the file's.
+    measured_costs: Option<CostModel>,
 }
 
 impl Watched {
     /// Watches the scenario at `scenario_file` (under `assets_root`), whose rules file says
-    /// `file_rules` now (before the command line's overrides).
-    pub fn new(scenario_file: String, assets_root: PathBuf, file_rules: LevelRules) -> Self {
+    /// `file_rules` now (before the command line's overrides), and plays by `measured_costs`
+    /// where the game measured them at start-up (else by the cost model's file).
+    pub fn new(
+        scenario_file: String,
+        assets_root: PathBuf,
+        file_rules: LevelRules,
+        measured_costs: Option<CostModel>,
+    ) -> Self {
         Self {
             scenario_file,
             assets_root,
@@ -53,6 +61,7 @@ impl Watched {
             game: default(),
             changed: false,
             file_rules: Some(file_rules),
+            measured_costs,
         }
     }
 
@@ -191,8 +200,12 @@ fn assemble(
     if waiting {
         return Ok(None);
     }
-    // The cost model is read from disk whenever the config is put together (not watched).
-    let costs = load_costs(&root, &root.join(&scenario.level_rules), rules)?;
+    // The cost model is read from disk whenever the config is put together (not watched),
+    // unless measured at start-up.
+    let costs = match &watched.measured_costs {
+        Some(measured) => measured.clone(),
+        None => load_costs(&root, &root.join(&scenario.level_rules), rules)?,
+    };
     SimConfig::assemble(
         &scenario_path,
         &root,

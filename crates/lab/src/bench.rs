@@ -249,6 +249,19 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
     }
 }
 
+/// How hard [`calibrate`] measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Calibration {
+    /// `simlod bench --calibrate`: every term, the median of three runs (about 5 s here).
+    Full,
+    /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): the median of two
+    /// shorter runs, and the crowd's shares kept from the model the files give, since the game
+    /// does not play a crowd of tens of thousands (about 1.5 s here).
+    AtStartUp,
+    /// One short run of every term (`--quick`): a rough figure in half a second.
+    Quick,
+}
+
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
 /// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
 /// of the scenario alone, in a court scaled to its density: each level's median frame, less
@@ -256,10 +269,14 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 /// one thread, as in a game), and the switch into the rigid level (see `switch_cost_us`). A
 /// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
 /// policy's own choice (see `choice_cost_us`), and the cheap levels' cost per creature in a
-/// crowd stepped across the cores, as shares of their cost on one thread.
-pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
-    let (warmup, frames, runs) = if quick { (10, 15, 1) } else { (30, 45, 3) };
-    let (cheap_count, rigid_count) = if quick { (400, 10) } else { (2000, 30) };
+/// crowd stepped across the cores, as shares of their cost on one thread (kept from
+/// `config.costs` [`Calibration::AtStartUp`]).
+pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
+    let (warmup, frames, runs, cheap_count, rigid_count) = match how {
+        Calibration::Full => (30, 45, 3, 2000, 30),
+        Calibration::AtStartUp => (15, 30, 2, 2000, 20),
+        Calibration::Quick => (10, 15, 1, 400, 10),
+    };
     let kinds = KindTable::of(config);
     // The median frame in microseconds of `count` creatures of `config` all under `policy`.
     let frame_us = |config: &SimConfig, count: u32, policy: LevelPolicy, runs: usize, frames: usize| {
@@ -322,6 +339,10 @@ pub fn calibrate(config: &SimConfig, quick: bool) -> CostModel {
     };
     let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, warmup, frames);
     (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
+    if how == Calibration::AtStartUp {
+        model.crowd_shares = config.costs.crowd_shares;
+        return model;
+    }
     // The cheap levels in a crowd, stepped across the cores: the scenario's mix at a crowd
     // size against the same at the count above, per creature.
     let crowd_count = 8 * simlod::PARALLEL_MIN_CREATURES;
@@ -389,6 +410,31 @@ fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
     };
     let (cheap_s, rigid_s) = (build_s(cheap), build_s(LevelPolicy::AllRigid));
     ((rigid_s - cheap_s) * 1e6 / f64::from(count)).max(0.0)
+}
+
+/// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
+/// choice's, and the crowd's shares.
+pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
+    let mut lines: Vec<String> = (model.kinds.iter())
+        .map(|k| {
+            let c = &k.costs;
+            format!(
+                "{:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
+                k.kind, c.point_mass_us_per_frame, c.hybrid_us_per_frame, c.rigid_us_per_frame, c.switch_to_rigid_us
+            )
+        })
+        .collect();
+    lines.push(format!(
+        "a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
+        model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
+    ));
+    if let Some(shares) = model.crowd_shares {
+        lines.push(format!(
+            "in a crowd (across the cores): point mass x {:.2}, hybrid x {:.2}",
+            shares.point_mass, shares.hybrid
+        ));
+    }
+    lines
 }
 
 /// The cost model as its file says it, with the command that measured it.
