@@ -256,7 +256,7 @@ pub enum Calibration {
     Full,
     /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): the median of two
     /// shorter runs, and the crowd's shares kept from the model the files give, since the game
-    /// does not play a crowd of tens of thousands (about 1.5 s here).
+    /// does not play a crowd of tens of thousands (about 1.3 s here).
     AtStartUp,
     /// One short run of every term (`--quick`): a rough figure in half a second.
     Quick,
@@ -274,7 +274,7 @@ pub enum Calibration {
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     let (warmup, frames, runs, cheap_count, rigid_count) = match how {
         Calibration::Full => (30, 45, 3, 2000, 30),
-        Calibration::AtStartUp => (15, 30, 2, 2000, 20),
+        Calibration::AtStartUp => (30, 30, 2, 2000, 20),
         Calibration::Quick => (10, 15, 1, 400, 10),
     };
     let kinds = KindTable::of(config);
