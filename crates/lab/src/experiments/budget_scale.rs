@@ -203,10 +203,19 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
 }
 
 fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
+    // The frames a game holds, and which of them, slowest first, is its 99th percentile: the
+    // slowest of all in a game under 100 frames (where a game's first frame, which builds the
+    // world's bodies, usually is).
+    let frames = games.first().map_or(0, |g| g.frames);
+    let p99_is = match frames - (frames as f64 * 0.99).ceil() as usize {
+        0 => "its slowest frame".to_owned(),
+        slower => format!("the slowest after the {slower} slowest"),
+    };
     let mut report = format!(
         "The budget policy under the scenario's own rules and cost model (the game's), seed {}, games of {} s: the scenario's mix, \
          the court grown with the count to the default game's density. Every frame's simulation timed on this machine's cores. \
-         The budget is kept where the mean frame is within 10 % of it and the 99th percentile within 25 %. \
+         The budget is kept where the mean frame is within 10 % of it and the 99th percentile within 25 %: a game is {frames} frames, \
+         and its 99th percentile is {p99_is}. \
          Over budget: the decisions where even the cheapest levels were predicted over it.\n\n\
          | creatures | budget (ms) | adaptive | mean frame (ms) | 99th percentile (ms) | predicted (ms) | kept | over budget | hybrid | rigid |\n\
          |---|---|---|---|---|---|---|---|---|---|\n",
