@@ -69,6 +69,31 @@ pub fn median_frame_seconds_of(sim: &mut HeadlessSim, warmup: usize, frames: usi
     )
 }
 
+/// The median over `runs` fresh runs of how much longer a frame of `config` takes than a frame
+/// of `base` run beside it, the two worlds stepped a frame each in turn (seconds). This
+/// machine runs fast and slow by spells of a fraction of a second, longer than a frame: a
+/// frame and its neighbour share the spell, so it cancels, where two figures taken apart
+/// differ by it.
+fn median_extra_of_runs(config: &SimConfig, base: &SimConfig, runs: usize, warmup: usize, frames: usize) -> f64 {
+    let timed = |sim: &mut HeadlessSim| {
+        let start = Instant::now();
+        sim.advance_frame();
+        start.elapsed().as_secs_f64()
+    };
+    median(
+        (0..runs)
+            .map(|_| {
+                let (mut sim, mut beside) = (HeadlessSim::new(config.clone()), HeadlessSim::new(base.clone()));
+                for _ in 0..warmup {
+                    sim.advance_frame();
+                    beside.advance_frame();
+                }
+                median((0..frames).map(|_| timed(&mut sim) - timed(&mut beside)).collect())
+            })
+            .collect(),
+    )
+}
+
 /// The median over `runs` fresh runs of their median frame times: one run's figure moves
 /// with whatever else the machine was doing while it ran.
 fn median_of_runs(config: &SimConfig, runs: usize, warmup: usize, frames: usize) -> f64 {
@@ -264,13 +289,13 @@ pub enum Calibration {
 
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
 /// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
-/// of the scenario alone, in a court scaled to its density: each level's median frame, less
-/// the fixed cost, divided by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so
-/// one thread, as in a game), and the switch into the rigid level (see `switch_cost_us`). A
-/// kind without an entry is predicted at the dearest calibrated kind's costs. Last, the budget
-/// policy's own choice (see `choice_cost_us`), and the cheap levels' cost per creature in a
-/// crowd stepped across the cores, as shares of their cost on one thread (kept from
-/// `config.costs` [`Calibration::AtStartUp`]).
+/// of the scenario alone, in a court scaled to its density: what each level's frame takes over
+/// the same court without creatures, stepped beside it (see `median_extra_of_runs`), divided
+/// by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so one thread, as in a
+/// game), and the switch into the rigid level (see `switch_cost_us`). A kind without an entry
+/// is predicted at the dearest calibrated kind's costs. Last, the budget policy's own choice
+/// (see `choice_cost_us`), and the cheap levels' cost per creature in a crowd stepped across
+/// the cores, as shares of their cost on one thread (at start-up, kept from `config.costs`).
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     let (warmup, frames, runs, cheap_count, rigid_count) = match how {
         Calibration::Full => (30, 45, 3, 2000, 30),
@@ -278,12 +303,19 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
         Calibration::Quick => (10, 15, 1, 400, 10),
     };
     let kinds = KindTable::of(config);
-    // The median frame in microseconds of `count` creatures of `config` all under `policy`.
-    let frame_us = |config: &SimConfig, count: u32, policy: LevelPolicy, runs: usize, frames: usize| {
-        median_of_runs(&scaled(config, count, policy), runs, warmup, frames) * 1e6
+    // Microseconds a frame of `count` creatures of `config` all under `policy` takes over the
+    // same court without them, per creature.
+    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy| {
+        let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
+        (median_extra_of_runs(&world, &court, runs, warmup, frames) * 1e6).max(0.0) / f64::from(count)
     };
-    // Cheap to measure and in every other figure: many frames, many runs.
-    let fixed_us = frame_us(config, 0, LevelPolicy::AllPointMass, 3 * runs, 5 * frames);
+    // Cheap to measure: many frames, many runs.
+    let fixed_us = median_of_runs(
+        &scaled(config, 0, LevelPolicy::AllPointMass),
+        3 * runs,
+        warmup,
+        5 * frames,
+    ) * 1e6;
     let mut entries = Vec::new();
     for def in &config.kinds {
         let alone = crate::scene::only_kind(config, &def.name);
@@ -295,7 +327,7 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
                 Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
-            us[level as usize] = (frame_us(&alone, count, policy, runs, frames) - fixed_us).max(0.0) / f64::from(count);
+            us[level as usize] = per_creature_us(&alone, count, policy);
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -347,8 +379,7 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     // size against the same at the count above, per creature.
     let crowd_count = 8 * simlod::PARALLEL_MIN_CREATURES;
     let share = |policy: LevelPolicy| {
-        let per_creature =
-            |count: u32| (frame_us(config, count, policy, runs, frames) - fixed_us).max(0.0) / f64::from(count);
+        let per_creature = |count: u32| per_creature_us(config, count, policy);
         (per_creature(crowd_count) / per_creature(cheap_count).max(1e-6)).clamp(0.01, 10.0) as f32
     };
     model.crowd_shares = Some(CrowdShares {
