@@ -305,7 +305,7 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     let kinds = KindTable::of(config);
     // Microseconds a frame of `count` creatures of `config` all under `policy` takes over the
     // same court without them, per creature.
-    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy| {
+    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy, runs: usize| {
         let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
         (median_extra_of_runs(&world, &court, runs, warmup, frames) * 1e6).max(0.0) / f64::from(count)
     };
@@ -327,7 +327,7 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
                 Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
-            us[level as usize] = per_creature_us(&alone, count, policy);
+            us[level as usize] = per_creature_us(&alone, count, policy, runs);
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -378,9 +378,14 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     // The cheap levels in a crowd, stepped across the cores: the scenario's mix at a crowd
     // size against the same at the count above, per creature.
     let crowd_count = 8 * simlod::PARALLEL_MIN_CREATURES;
+    // The median of the runs' ratios, each of two figures taken one after the other: taken
+    // apart, a slow spell of the machine under one of them moved the ratio by a third.
     let share = |policy: LevelPolicy| {
-        let per_creature = |count: u32| per_creature_us(config, count, policy);
-        (per_creature(crowd_count) / per_creature(cheap_count).max(1e-6)).clamp(0.01, 10.0) as f32
+        let ratios = (0..runs).map(|_| {
+            let crowd = per_creature_us(config, crowd_count, policy, 1);
+            crowd / per_creature_us(config, cheap_count, policy, 1).max(1e-6)
+        });
+        median(ratios.collect()).clamp(0.01, 10.0) as f32
     };
     model.crowd_shares = Some(CrowdShares {
         point_mass: share(LevelPolicy::AllPointMass),
