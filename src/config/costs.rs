@@ -35,6 +35,13 @@ pub struct CostModel {
     /// file without it predicts a crowd at those figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_shares: Option<CrowdShares>,
+    /// The same shares measured at larger crowds, smallest first: a crowd's share is
+    /// interpolated on the logarithm of its count between the two measured nearest it (a
+    /// creature costs less the larger the crowd); a crowd beyond the largest measured, or
+    /// short of the smallest, takes its share. A file without them takes `crowd_shares` for
+    /// every crowd.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub larger_crowd_shares: Vec<CrowdShares>,
 }
 
 /// The cheap levels' cost per creature in a crowd of [`PARALLEL_MIN_CREATURES`] or more, as
@@ -42,10 +49,20 @@ pub struct CostModel {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CrowdShares {
+    /// The crowd they were measured at, [`PARALLEL_MIN_CREATURES`] or more (a file without it
+    /// was measured at 16,384, as every calibration was before it).
+    #[serde(default = "CrowdShares::first_measured_at")]
+    pub creatures: u32,
     /// Of the point-mass level's cost.
     pub point_mass: f32,
     /// Of the hybrid level's cost.
     pub hybrid: f32,
+}
+
+impl CrowdShares {
+    fn first_measured_at() -> u32 {
+        16_384
+    }
 }
 
 /// A kind's costs, by name.
@@ -117,11 +134,33 @@ impl CostModel {
     /// levels at their crowd shares.
     pub fn in_crowd(&self, kind: &str, creatures: u32) -> LevelCosts {
         let mut costs = *self.of(kind);
-        if let Some(shares) = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES) {
-            costs.point_mass_us_per_frame *= shares.point_mass;
-            costs.hybrid_us_per_frame *= shares.hybrid;
+        if let Some((point_mass, hybrid)) = self.shares_in_crowd(creatures) {
+            costs.point_mass_us_per_frame *= point_mass;
+            costs.hybrid_us_per_frame *= hybrid;
         }
         costs
+    }
+
+    /// The cheap levels' shares in a world of `creatures` (see `larger_crowd_shares`): none
+    /// short of a crowd.
+    fn shares_in_crowd(&self, creatures: u32) -> Option<(f32, f32)> {
+        let first = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES)?;
+        let measured = std::iter::once(&first).chain(&self.larger_crowd_shares);
+        let (mut below, n) = (first, creatures as f32);
+        for above in measured {
+            if above.creatures as f32 >= n {
+                let (lo, hi) = ((below.creatures as f32).ln(), (above.creatures as f32).ln());
+                let t = if hi > lo {
+                    ((n.ln() - lo) / (hi - lo)).clamp(0.0, 1.0)
+                } else {
+                    1.0
+                };
+                let at = |b: f32, a: f32| b + (a - b) * t;
+                return Some((at(below.point_mass, above.point_mass), at(below.hybrid, above.hybrid)));
+            }
+            below = *above;
+        }
+        Some((below.point_mass, below.hybrid))
     }
 
     /// The costs of the kind named `kind`.
@@ -153,11 +192,30 @@ impl Validate for CostModel {
             LevelCosts::MOST_US,
         );
         v.within("contact_search_us", self.contact_search_us, 0.0, LevelCosts::MOST_US);
-        if let Some(shares) = self.crowd_shares {
-            v.nested("crowd_shares", |v| {
-                v.within("point_mass", shares.point_mass, 0.01, 10.0);
-                v.within("hybrid", shares.hybrid, 0.01, 10.0);
-            });
+        let shares = |v: &mut Validator, shares: &CrowdShares, smallest: u32| {
+            v.require(
+                shares.creatures >= smallest,
+                "creatures",
+                format!(
+                    "must be at least {smallest} (larger than the crowd before), got {}",
+                    shares.creatures
+                ),
+            );
+            v.within("point_mass", shares.point_mass, 0.01, 10.0);
+            v.within("hybrid", shares.hybrid, 0.01, 10.0);
+        };
+        if let Some(first) = &self.crowd_shares {
+            v.nested("crowd_shares", |v| shares(v, first, PARALLEL_MIN_CREATURES));
+        } else if !self.larger_crowd_shares.is_empty() {
+            v.fail(
+                "larger_crowd_shares",
+                "needs crowd_shares, the shares at the smallest crowd",
+            );
+        }
+        let mut smallest = self.crowd_shares.map_or(0, |s| s.creatures + 1);
+        for (i, larger) in self.larger_crowd_shares.iter().enumerate() {
+            v.nested(&format!("larger_crowd_shares[{i}]"), |v| shares(v, larger, smallest));
+            smallest = larger.creatures + 1;
         }
     }
 }
@@ -202,5 +260,37 @@ mod tests {
         let bad = text.replace("0.25", "0");
         let err = parse_ron::<CostModel>(bad.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`crowd_shares.hybrid`"), "{err}");
+    }
+
+    #[test]
+    fn a_crowd_between_two_measured_takes_a_share_between_theirs_on_the_logarithm_of_its_count() {
+        let text = format!(
+            "(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((creatures: 4096, point_mass: 1.0, hybrid: 1.0)), \
+             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75)])"
+        );
+        let model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
+        let point_mass = |n| model.in_crowd("hopper", n).point_mass_us_per_frame;
+        // The smallest crowd's share down to the smallest crowd, the largest's beyond it.
+        assert_eq!(point_mass(PARALLEL_MIN_CREATURES), 1.0);
+        assert_eq!(point_mass(4096), 1.0);
+        assert_eq!(point_mass(1_000_000), 0.25);
+        // Halfway on the logarithm: 8,192 between 4,096 and 16,384; 32,768 past 16,384.
+        assert!((point_mass(8192) - 0.75).abs() < 1e-5, "{}", point_mass(8192));
+        assert!((point_mass(32_768) - 0.375).abs() < 1e-5, "{}", point_mass(32_768));
+        assert_eq!(point_mass(16_384), 0.5);
+        assert!((model.in_crowd("hopper", 8192).hybrid_us_per_frame - 1.75).abs() < 1e-5);
+        // A file of one share, from before the counts: measured at 16,384, for every crowd.
+        let old: CostModel = parse_ron(
+            format!("(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((point_mass: 0.5, hybrid: 0.5)))").as_bytes(),
+            Path::new("costs.ron"),
+        )
+        .unwrap();
+        assert_eq!(old.crowd_shares.unwrap().creatures, 16_384);
+        assert_eq!(old.in_crowd("hopper", 3000).point_mass_us_per_frame, 0.5);
+        assert_eq!(old.in_crowd("hopper", 1_000_000).point_mass_us_per_frame, 0.5);
+        // Counts out of order are refused, and named.
+        let unordered = text.replace("creatures: 65536", "creatures: 8192");
+        let err = parse_ron::<CostModel>(unordered.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(err.to_string().contains("`larger_crowd_shares[1].creatures`"), "{err}");
     }
 }

@@ -29,6 +29,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         decision_us_per_creature: 0.0,
         contact_search_us: 0.0,
         crowd_shares: None,
+        larger_crowd_shares: Vec::new(),
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config

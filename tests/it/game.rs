@@ -537,6 +537,7 @@ fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares
         "{measured:?}"
     );
     // A crowd of tens of thousands is not measured at start-up: its shares are the file's.
-    assert!(config.costs.crowd_shares.is_some());
+    assert!(config.costs.crowd_shares.is_some() && !config.costs.larger_crowd_shares.is_empty());
     assert_eq!(measured.crowd_shares, config.costs.crowd_shares);
+    assert_eq!(measured.larger_crowd_shares, config.costs.larger_crowd_shares);
 }

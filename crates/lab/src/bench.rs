@@ -277,13 +277,14 @@ fn game_speedup(config: &SimConfig, runs: usize, warmup: usize, frames: usize, j
 /// How hard [`calibrate`] measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Calibration {
-    /// `simlod bench --calibrate`: every term, the median of three runs (about 5 s here).
+    /// `simlod bench --calibrate`: every figure the median of three passes over all of them
+    /// (about 10 s here).
     Full,
-    /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): the median of two
-    /// shorter runs, and the crowd's shares kept from the model the files give, since the game
-    /// does not play a crowd of tens of thousands (about 1.3 s here).
+    /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): three shorter
+    /// passes, and the crowd's shares kept from the model the files give, since the game does
+    /// not play a crowd of tens of thousands (about 1.6 s here).
     AtStartUp,
-    /// One short run of every term (`--quick`): a rough figure in half a second.
+    /// One short pass (`--quick`): a rough figure in half a second.
     Quick,
 }
 
@@ -297,11 +298,24 @@ pub enum Calibration {
 /// (see `choice_cost_us`), and the cheap levels' cost per creature in a crowd stepped across
 /// the cores, as shares of their cost on one thread (at start-up, kept from `config.costs`).
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
-    let (warmup, frames, runs, cheap_count, rigid_count) = match how {
-        Calibration::Full => (30, 45, 3, 2000, 30),
-        Calibration::AtStartUp => (30, 30, 2, 2000, 20),
-        Calibration::Quick => (10, 15, 1, 400, 10),
+    // Whole passes over every figure, each figure the median of the passes': a pass takes a
+    // few seconds, and this machine has slow spells as long (rigid creatures and the fixed
+    // cost measured a third dearer throughout one calibration, and not in the next).
+    let passes = match how {
+        Calibration::Full | Calibration::AtStartUp => 3,
+        Calibration::Quick => 1,
     };
+    median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>())
+}
+
+/// One pass of [`calibrate`]: every figure measured once.
+fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
+    let (warmup, frames, cheap_count, rigid_count) = match how {
+        Calibration::Full => (30, 45, 2000, 30),
+        Calibration::AtStartUp => (20, 20, 2000, 20),
+        Calibration::Quick => (10, 15, 400, 10),
+    };
+    let runs = 1;
     let kinds = KindTable::of(config);
     // Microseconds a frame of `count` creatures of `config` all under `policy` takes over the
     // same court without them, per creature.
@@ -368,30 +382,83 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
         decision_us_per_creature: 0.0,
         contact_search_us: 0.0,
         crowd_shares: None,
+        larger_crowd_shares: Vec::new(),
     };
     let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, warmup, frames);
     (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
     if how == Calibration::AtStartUp {
         model.crowd_shares = config.costs.crowd_shares;
+        model.larger_crowd_shares = config.costs.larger_crowd_shares.clone();
         return model;
     }
-    // The cheap levels in a crowd, stepped across the cores: the scenario's mix at a crowd
-    // size against the same at the count above, per creature.
-    let crowd_count = 8 * simlod::PARALLEL_MIN_CREATURES;
-    // The median of the runs' ratios, each of two figures taken one after the other: taken
-    // apart, a slow spell of the machine under one of them moved the ratio by a third.
-    let share = |policy: LevelPolicy| {
-        let ratios = (0..runs).map(|_| {
-            let crowd = per_creature_us(config, crowd_count, policy, 1);
-            crowd / per_creature_us(config, cheap_count, policy, 1).max(1e-6)
-        });
-        median(ratios.collect()).clamp(0.01, 10.0) as f32
+    // The cheap levels in crowds stepped across the cores: the scenario's mix at each crowd
+    // size against the same below a crowd, per creature (a creature costs less the larger the
+    // crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two thirds of it).
+    let crowds: &[u32] = match how {
+        Calibration::Quick => &[2 * simlod::PARALLEL_MIN_CREATURES],
+        _ => &[2, 8, 32].map(|k| k * simlod::PARALLEL_MIN_CREATURES),
     };
-    model.crowd_shares = Some(CrowdShares {
-        point_mass: share(LevelPolicy::AllPointMass),
-        hybrid: share(LevelPolicy::AllHybrid),
-    });
+    // The median of the runs' ratios, each of figures taken one after the other: taken apart,
+    // a slow spell of the machine under one of them moved the ratio by a third.
+    let shares = |policy: LevelPolicy| -> Vec<f32> {
+        let ratios: Vec<Vec<f64>> = (0..runs)
+            .map(|_| {
+                let alone = per_creature_us(config, cheap_count, policy, 1).max(1e-6);
+                (crowds.iter())
+                    .map(|&count| per_creature_us(config, count, policy, 1) / alone)
+                    .collect()
+            })
+            .collect();
+        (0..crowds.len())
+            .map(|i| median(ratios.iter().map(|run| run[i]).collect()).clamp(0.01, 10.0) as f32)
+            .collect()
+    };
+    let (point_mass, hybrid) = (shares(LevelPolicy::AllPointMass), shares(LevelPolicy::AllHybrid));
+    let mut measured =
+        (crowds.iter().zip(point_mass.iter().zip(&hybrid))).map(|(&creatures, (&point_mass, &hybrid))| CrowdShares {
+            creatures,
+            point_mass,
+            hybrid,
+        });
+    model.crowd_shares = measured.next();
+    model.larger_crowd_shares = measured.collect();
     model
+}
+
+/// Each figure of `models` (the same kinds and crowds, in the same order) the median of theirs.
+fn median_model(models: &[CostModel]) -> CostModel {
+    let median_of =
+        |figure: &dyn Fn(&CostModel) -> f32| median(models.iter().map(|m| f64::from(figure(m))).collect()) as f32;
+    let costs_of = |costs: &dyn Fn(&CostModel) -> &LevelCosts| LevelCosts {
+        point_mass_us_per_frame: median_of(&|m| costs(m).point_mass_us_per_frame),
+        hybrid_us_per_frame: median_of(&|m| costs(m).hybrid_us_per_frame),
+        rigid_us_per_frame: median_of(&|m| costs(m).rigid_us_per_frame),
+        switch_to_rigid_us: median_of(&|m| costs(m).switch_to_rigid_us),
+    };
+    let shares_of = |shares: &dyn Fn(&CostModel) -> &CrowdShares| CrowdShares {
+        creatures: shares(&models[0]).creatures,
+        point_mass: median_of(&|m| shares(m).point_mass),
+        hybrid: median_of(&|m| shares(m).hybrid),
+    };
+    let first = &models[0];
+    CostModel {
+        kinds: (first.kinds.iter().enumerate())
+            .map(|(i, k)| KindCosts {
+                kind: k.kind.clone(),
+                costs: costs_of(&|m| &m.kinds[i].costs),
+            })
+            .collect(),
+        other_kinds: costs_of(&|m| &m.other_kinds),
+        fixed_us_per_frame: median_of(&|m| m.fixed_us_per_frame),
+        decision_us_per_creature: median_of(&|m| m.decision_us_per_creature),
+        contact_search_us: median_of(&|m| m.contact_search_us),
+        crowd_shares: first
+            .crowd_shares
+            .map(|_| shares_of(&|m| m.crowd_shares.as_ref().expect("every pass measures the same crowds"))),
+        larger_crowd_shares: (0..first.larger_crowd_shares.len())
+            .map(|i| shares_of(&|m| &m.larger_crowd_shares[i]))
+            .collect(),
+    }
 }
 
 /// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up,
@@ -464,10 +531,10 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
         "a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
         model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
     ));
-    if let Some(shares) = model.crowd_shares {
+    for shares in model.crowd_shares.iter().chain(&model.larger_crowd_shares) {
         lines.push(format!(
-            "in a crowd (across the cores): point mass x {:.2}, hybrid x {:.2}",
-            shares.point_mass, shares.hybrid
+            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}",
+            shares.creatures, shares.point_mass, shares.hybrid
         ));
     }
     lines
