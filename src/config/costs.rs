@@ -31,8 +31,8 @@ pub struct CostModel {
     #[serde(default)]
     pub contact_search_us: f32,
     /// What the point-mass and hybrid levels cost per creature in a crowd, where they are
-    /// stepped across the cores, as shares of the figures above (measured on one thread). A
-    /// file without it predicts a crowd at those figures.
+    /// stepped across the cores, as shares of the figures above (measured on one thread): at
+    /// the smallest crowd measured. A file without it predicts a crowd at those figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_shares: Option<CrowdShares>,
     /// The same shares measured at larger crowds, smallest first: a crowd's share is
@@ -192,30 +192,37 @@ impl Validate for CostModel {
             LevelCosts::MOST_US,
         );
         v.within("contact_search_us", self.contact_search_us, 0.0, LevelCosts::MOST_US);
-        let shares = |v: &mut Validator, shares: &CrowdShares, smallest: u32| {
+        let shares = |v: &mut Validator, shares: &CrowdShares, smallest: u32, why: &str| {
             v.require(
                 shares.creatures >= smallest,
                 "creatures",
-                format!(
-                    "must be at least {smallest} (larger than the crowd before), got {}",
-                    shares.creatures
-                ),
+                format!("must be at least {smallest} ({why}), got {}", shares.creatures),
             );
             v.within("point_mass", shares.point_mass, 0.01, 10.0);
             v.within("hybrid", shares.hybrid, 0.01, 10.0);
         };
         if let Some(first) = &self.crowd_shares {
-            v.nested("crowd_shares", |v| shares(v, first, PARALLEL_MIN_CREATURES));
+            v.nested("crowd_shares", |v| {
+                shares(
+                    v,
+                    first,
+                    PARALLEL_MIN_CREATURES,
+                    "the smallest crowd stepped across the cores",
+                )
+            });
         } else if !self.larger_crowd_shares.is_empty() {
             v.fail(
                 "larger_crowd_shares",
                 "needs crowd_shares, the shares at the smallest crowd",
             );
         }
-        let mut smallest = self.crowd_shares.map_or(0, |s| s.creatures + 1);
+        let mut before = self.crowd_shares.map_or(0, |s| s.creatures);
         for (i, larger) in self.larger_crowd_shares.iter().enumerate() {
-            v.nested(&format!("larger_crowd_shares[{i}]"), |v| shares(v, larger, smallest));
-            smallest = larger.creatures + 1;
+            let smallest = before.saturating_add(1);
+            v.nested(&format!("larger_crowd_shares[{i}]"), |v| {
+                shares(v, larger, smallest, "larger than the crowd before")
+            });
+            before = larger.creatures;
         }
     }
 }
@@ -292,5 +299,8 @@ mod tests {
         let unordered = text.replace("creatures: 65536", "creatures: 8192");
         let err = parse_ron::<CostModel>(unordered.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`larger_crowd_shares[1].creatures`"), "{err}");
+        let last = text.replace("creatures: 4096", &format!("creatures: {}", u32::MAX));
+        let err = parse_ron::<CostModel>(last.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(err.to_string().contains("`larger_crowd_shares[0].creatures`"), "{err}");
     }
 }

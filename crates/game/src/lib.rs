@@ -80,12 +80,14 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
         )));
     }
     let scenario_asset = asset_path(&options.assets, &options.scenario)?;
+    let mut app = App::new();
+    add_window_plugins(&mut app, &options)?;
+    // After the window's plugins: the display is there, and the task pools are the game's, so
+    // the costs are measured as the game will run.
     let measured_costs = looks.frame_budget.calibrate_at_start.then(|| measure_costs(&config));
     if let Some(model) = &measured_costs {
         config.costs = model.clone();
     }
-    let mut app = App::new();
-    add_window_plugins(&mut app, &options)?;
     app.add_plugins(SimPlugin::new(config))
         .insert_resource(GameSettings(looks))
         .insert_resource(reload::Watched::new(
@@ -107,18 +109,17 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
 /// The budget policy's cost model measured on this machine, said on the terminal: a model
 /// measured on another machine, or on another day, is off by as much as the machines differ.
 fn measure_costs(config: &SimConfig) -> CostModel {
-    eprintln!(
-        "measuring the budget policy's costs on this machine (frame_budget.calibrate_at_start in {GAME_FILE})..."
-    );
+    info!("measuring the budget policy's costs on this machine (frame_budget.calibrate_at_start in {GAME_FILE})");
     let start = std::time::Instant::now();
     let model = simlod_lab::bench::calibrate(config, simlod_lab::bench::Calibration::AtStartUp);
-    eprintln!(
+    let mut said = format!(
         "measured in {:.1} s (us per creature per 1/30 s):",
         start.elapsed().as_secs_f32()
     );
     for line in simlod_lab::bench::cost_model_lines(&model) {
-        eprintln!("  {line}");
+        said += &format!("\n  {line}");
     }
+    info!("{said}");
     model
 }
 

@@ -58,38 +58,29 @@ pub fn median_frame_seconds_of(sim: &mut HeadlessSim, warmup: usize, frames: usi
     for _ in 0..warmup {
         sim.advance_frame();
     }
-    median(
-        (0..frames)
-            .map(|_| {
-                let start = Instant::now();
-                sim.advance_frame();
-                start.elapsed().as_secs_f64()
-            })
-            .collect(),
-    )
+    median((0..frames).map(|_| timed_frame(sim)).collect())
 }
 
-/// The median over `runs` fresh runs of how much longer a frame of `config` takes than a frame
-/// of `base` run beside it, the two worlds stepped a frame each in turn (seconds). This
-/// machine runs fast and slow by spells of a fraction of a second, longer than a frame: a
-/// frame and its neighbour share the spell, so it cancels, where two figures taken apart
-/// differ by it.
-fn median_extra_of_runs(config: &SimConfig, base: &SimConfig, runs: usize, warmup: usize, frames: usize) -> f64 {
-    let timed = |sim: &mut HeadlessSim| {
-        let start = Instant::now();
+/// One frame of `sim`, in seconds of wall time.
+fn timed_frame(sim: &mut HeadlessSim) -> f64 {
+    let start = Instant::now();
+    sim.advance_frame();
+    start.elapsed().as_secs_f64()
+}
+
+/// How much longer a frame of `config` takes than a frame of `base` run beside it, the two
+/// worlds stepped a frame each in turn: the median, in seconds. This machine runs fast and
+/// slow by spells of a fraction of a second, longer than a frame: a frame and its neighbour
+/// share the spell, so it cancels, where two figures taken apart differ by it.
+fn median_extra_seconds(config: &SimConfig, base: &SimConfig, warmup: usize, frames: usize) -> f64 {
+    let (mut sim, mut beside) = (HeadlessSim::new(config.clone()), HeadlessSim::new(base.clone()));
+    for _ in 0..warmup {
         sim.advance_frame();
-        start.elapsed().as_secs_f64()
-    };
+        beside.advance_frame();
+    }
     median(
-        (0..runs)
-            .map(|_| {
-                let (mut sim, mut beside) = (HeadlessSim::new(config.clone()), HeadlessSim::new(base.clone()));
-                for _ in 0..warmup {
-                    sim.advance_frame();
-                    beside.advance_frame();
-                }
-                median((0..frames).map(|_| timed(&mut sim) - timed(&mut beside)).collect())
-            })
+        (0..frames)
+            .map(|_| timed_frame(&mut sim) - timed_frame(&mut beside))
             .collect(),
     )
 }
@@ -282,7 +273,7 @@ pub enum Calibration {
     Full,
     /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): three shorter
     /// passes, and the crowd's shares kept from the model the files give, since the game does
-    /// not play a crowd of tens of thousands (about 1.6 s here).
+    /// not play a crowd of tens of thousands (about 1.3 s here).
     AtStartUp,
     /// One short pass (`--quick`): a rough figure in half a second.
     Quick,
@@ -291,7 +282,7 @@ pub enum Calibration {
 /// `simlod bench --calibrate`: the budget policy's cost model from measured medians. First the
 /// fixed cost of a frame: the scenario's court and puck without creatures. Then for each kind
 /// of the scenario alone, in a court scaled to its density: what each level's frame takes over
-/// the same court without creatures, stepped beside it (see `median_extra_of_runs`), divided
+/// a court without creatures stepped beside it (see `median_extra_seconds`), divided
 /// by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so one thread, as in a
 /// game), and the switch into the rigid level (see `switch_cost_us`). A kind without an entry
 /// is predicted at the dearest calibrated kind's costs. Last, the budget policy's own choice
@@ -315,21 +306,15 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         Calibration::AtStartUp => (20, 20, 2000, 20),
         Calibration::Quick => (10, 15, 400, 10),
     };
-    let runs = 1;
     let kinds = KindTable::of(config);
-    // Microseconds a frame of `count` creatures of `config` all under `policy` takes over the
-    // same court without them, per creature.
-    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy, runs: usize| {
+    // Microseconds a frame of `count` creatures of `config` all under `policy` takes over a
+    // court without creatures, per creature.
+    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy| {
         let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
-        (median_extra_of_runs(&world, &court, runs, warmup, frames) * 1e6).max(0.0) / f64::from(count)
+        (median_extra_seconds(&world, &court, warmup, frames) * 1e6).max(0.0) / f64::from(count)
     };
-    // Cheap to measure: many frames, many runs.
-    let fixed_us = median_of_runs(
-        &scaled(config, 0, LevelPolicy::AllPointMass),
-        3 * runs,
-        warmup,
-        5 * frames,
-    ) * 1e6;
+    // Cheap to measure: many frames, several runs.
+    let fixed_us = median_of_runs(&scaled(config, 0, LevelPolicy::AllPointMass), 3, warmup, 5 * frames) * 1e6;
     let mut entries = Vec::new();
     for def in &config.kinds {
         let alone = crate::scene::only_kind(config, &def.name);
@@ -341,7 +326,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
                 Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
-            us[level as usize] = per_creature_us(&alone, count, policy, runs);
+            us[level as usize] = per_creature_us(&alone, count, policy);
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -350,11 +335,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
             }
         }
         let switch_us = if levels.contains(&Lod::Rigid) {
-            median(
-                (0..runs)
-                    .map(|_| switch_cost_us(&alone, 4 * rigid_count, levels[levels.len() - 2]))
-                    .collect(),
-            )
+            switch_cost_us(&alone, 4 * rigid_count, levels[levels.len() - 2])
         } else {
             0.0
         };
@@ -368,16 +349,9 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
             },
         });
     }
-    let dearest = |f: fn(&LevelCosts) -> f32| entries.iter().map(|k| f(&k.costs)).fold(0.0, f32::max);
-    let other_kinds = LevelCosts {
-        point_mass_us_per_frame: dearest(|c| c.point_mass_us_per_frame),
-        hybrid_us_per_frame: dearest(|c| c.hybrid_us_per_frame),
-        rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
-        switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
-    };
     let mut model = CostModel {
+        other_kinds: dearest(&entries),
         kinds: entries,
-        other_kinds,
         fixed_us_per_frame: fixed_us as f32,
         decision_us_per_creature: 0.0,
         contact_search_us: 0.0,
@@ -395,22 +369,15 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     // size against the same below a crowd, per creature (a creature costs less the larger the
     // crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two thirds of it).
     let crowds: &[u32] = match how {
-        Calibration::Quick => &[2 * simlod::PARALLEL_MIN_CREATURES],
+        Calibration::Quick => &[8 * simlod::PARALLEL_MIN_CREATURES],
         _ => &[2, 8, 32].map(|k| k * simlod::PARALLEL_MIN_CREATURES),
     };
-    // The median of the runs' ratios, each of figures taken one after the other: taken apart,
-    // a slow spell of the machine under one of them moved the ratio by a third.
+    // Each crowd's figure right after the one-thread figure it is a share of: taken apart, a
+    // slow spell of the machine under one of them moved the share by a third.
     let shares = |policy: LevelPolicy| -> Vec<f32> {
-        let ratios: Vec<Vec<f64>> = (0..runs)
-            .map(|_| {
-                let alone = per_creature_us(config, cheap_count, policy, 1).max(1e-6);
-                (crowds.iter())
-                    .map(|&count| per_creature_us(config, count, policy, 1) / alone)
-                    .collect()
-            })
-            .collect();
-        (0..crowds.len())
-            .map(|i| median(ratios.iter().map(|run| run[i]).collect()).clamp(0.01, 10.0) as f32)
+        let alone = per_creature_us(config, cheap_count, policy).max(1e-6);
+        (crowds.iter())
+            .map(|&count| (per_creature_us(config, count, policy) / alone).clamp(0.01, 10.0) as f32)
             .collect()
     };
     let (point_mass, hybrid) = (shares(LevelPolicy::AllPointMass), shares(LevelPolicy::AllHybrid));
@@ -441,14 +408,14 @@ fn median_model(models: &[CostModel]) -> CostModel {
         hybrid: median_of(&|m| shares(m).hybrid),
     };
     let first = &models[0];
-    CostModel {
+    let mut model = CostModel {
         kinds: (first.kinds.iter().enumerate())
             .map(|(i, k)| KindCosts {
                 kind: k.kind.clone(),
                 costs: costs_of(&|m| &m.kinds[i].costs),
             })
             .collect(),
-        other_kinds: costs_of(&|m| &m.other_kinds),
+        other_kinds: LevelCosts::default(),
         fixed_us_per_frame: median_of(&|m| m.fixed_us_per_frame),
         decision_us_per_creature: median_of(&|m| m.decision_us_per_creature),
         contact_search_us: median_of(&|m| m.contact_search_us),
@@ -458,6 +425,19 @@ fn median_model(models: &[CostModel]) -> CostModel {
         larger_crowd_shares: (0..first.larger_crowd_shares.len())
             .map(|i| shares_of(&|m| &m.larger_crowd_shares[i]))
             .collect(),
+    };
+    model.other_kinds = dearest(&model.kinds);
+    model
+}
+
+/// What a kind without an entry is predicted at: the dearest calibrated kind's each cost.
+fn dearest(kinds: &[KindCosts]) -> LevelCosts {
+    let dearest = |f: fn(&LevelCosts) -> f32| kinds.iter().map(|k| f(&k.costs)).fold(0.0, f32::max);
+    LevelCosts {
+        point_mass_us_per_frame: dearest(|c| c.point_mass_us_per_frame),
+        hybrid_us_per_frame: dearest(|c| c.hybrid_us_per_frame),
+        rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
+        switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
     }
 }
 
