@@ -114,6 +114,23 @@ fn watching_app_overriding(
     app
 }
 
+/// Updates the app long enough for the asset server's first loads to arrive.
+fn let_the_first_loads_settle(app: &mut App) {
+    for _ in 0..50 {
+        app.update();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// `of` the config running now and of the one the next round starts from.
+fn running_and_next<T>(app: &App, of: impl Fn(&SimConfig) -> T) -> [T; 2] {
+    [
+        app.world().resource::<SimConfig>(),
+        &app.world().resource::<BaseConfig>().0,
+    ]
+    .map(of)
+}
+
 /// Edits the file at `path` as a modder would: its first `from` becomes `to`.
 fn edit(path: &Path, from: &str, to: &str) {
     let text = std::fs::read_to_string(path).unwrap();
@@ -141,10 +158,7 @@ fn a_bad_edit_is_reported_and_the_last_good_values_stay_until_a_good_edit_restar
     let puck_speed = |app: &mut App| app.world().resource::<SimConfig>().arena.puck.speed_m_per_s;
     let seconds = |app: &mut App| app.world().resource::<simlod::SimClock>().seconds();
     // Let the first loads settle.
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let_the_first_loads_settle(&mut app);
     assert!(app.world().resource::<Problems>().0.is_empty());
     assert_eq!(app.world().resource::<Round>().number, 0);
 
@@ -190,10 +204,7 @@ fn a_frame_budget_given_at_start_outlives_the_first_loads_and_yields_to_an_edit_
     let root = copy_assets("frame_budget_override");
     let mut app = watching_app_overriding(&root, |c| c.rules.budget.frame_budget_ms = 0.7, None);
     let budget = |app: &mut App| app.world().resource::<SimConfig>().rules.budget.frame_budget_ms;
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let_the_first_loads_settle(&mut app);
     assert!(app.world().resource::<Problems>().0.is_empty());
     assert_eq!(budget(&mut app), 0.7, "the files' first loads keep the override");
     let rules = std::fs::read_to_string(root.join("rules/levels.ron")).unwrap();
@@ -243,10 +254,7 @@ fn without_a_display_the_game_says_so_in_one_sentence_and_points_to_run() {
 fn an_edited_gait_table_is_watched_like_the_other_files() {
     let root = copy_assets("hot_reload_gait");
     let mut app = watching_app(&root);
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let_the_first_loads_settle(&mut app);
     let file = root.join("gaits/hopper.ron");
     let table = std::fs::read_to_string(&file).unwrap();
     let with_top_speed = |v: &str| {
@@ -275,10 +283,7 @@ fn an_edited_gait_table_is_watched_like_the_other_files() {
 fn an_edited_rules_file_applies_to_the_running_round_and_a_bad_one_is_named() {
     let root = copy_assets("hot_reload_rules");
     let mut app = watching_app(&root);
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let_the_first_loads_settle(&mut app);
     let puck_radius = |app: &mut App| app.world().resource::<SimConfig>().rules.influence.puck_radius_m;
     assert_eq!(puck_radius(&mut app), 10.0);
     let file = root.join("rules/levels.ron");
@@ -308,23 +313,14 @@ fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
     let mut app = watching_app(&root);
     let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
     app.insert_resource(GameSettings(looks.clone()));
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
+    let_the_first_loads_settle(&mut app);
     // As the radius keys do: the running rules and the next rounds'.
     let mut tuned = app.world().resource::<SimConfig>().rules.clone();
     tuned.influence.puck_radius_m = 13.0;
     tuned.camera.radius_m = 7.0;
     app.world_mut().resource_mut::<SimConfig>().rules = tuned.clone();
     app.world_mut().resource_mut::<BaseConfig>().rules = tuned;
-    let radii = |app: &mut App| {
-        [
-            app.world().resource::<SimConfig>(),
-            &app.world().resource::<BaseConfig>().0,
-        ]
-        .map(|c| (c.rules.influence.puck_radius_m, c.rules.camera.radius_m))
-    };
+    let radii = |app: &mut App| running_and_next(app, |c| (c.rules.influence.puck_radius_m, c.rules.camera.radius_m));
 
     let file = root.join("game.ron");
     let text = std::fs::read_to_string(&file).unwrap();
@@ -442,17 +438,8 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
     assert_eq!(looks.frame_budget.adaptive_frames, 30.0, "as shipped");
     app.insert_resource(GameSettings(looks.clone()));
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let adaptive = |app: &mut App| {
-        [
-            app.world().resource::<SimConfig>(),
-            &app.world().resource::<BaseConfig>().0,
-        ]
-        .map(|c| c.rules.budget.adaptive_frames)
-    };
+    let_the_first_loads_settle(&mut app);
+    let adaptive = |app: &mut App| running_and_next(app, |c| c.rules.budget.adaptive_frames);
     // An edit of the rules (which leave the adaptive mode off) runs with the game's.
     let (rules_file, game_file) = (root.join("rules/levels.ron"), root.join("game.ron"));
     assert!(
@@ -494,17 +481,8 @@ fn the_costs_measured_at_start_up_stand_through_edits_of_the_rules_and_of_the_sc
         k.costs.rigid_us_per_frame *= 2.0;
     }
     let mut app = watching_app_overriding(&root, |_| {}, Some(measured.clone()));
-    for _ in 0..50 {
-        app.update();
-        std::thread::sleep(Duration::from_millis(10));
-    }
-    let costs = |app: &mut App| {
-        [
-            app.world().resource::<SimConfig>(),
-            &app.world().resource::<BaseConfig>().0,
-        ]
-        .map(|c| c.costs.clone())
-    };
+    let_the_first_loads_settle(&mut app);
+    let costs = |app: &mut App| running_and_next(app, |c| c.costs.clone());
     assert_eq!(costs(&mut app), [measured.clone(), measured.clone()]);
     // The rules edited: they apply, the measured model stays.
     edit(&root.join("rules/levels.ron"), "min_dwell_s: 0.5", "min_dwell_s: 0.4");

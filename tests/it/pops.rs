@@ -5,11 +5,12 @@
 use bevy::prelude::*;
 
 use crate::support::*;
-use simlod::config::SimConfig;
+use simlod::config::{SimConfig, load_file};
 use simlod::creature::DesiredVelocity;
 use simlod::lod::{LevelPolicy, Lod};
 use simlod::models::rigid::Shove;
 use simlod_lab::experiments::lone_creature;
+use std::path::Path;
 
 /// A game of the shipped kinds under the combined policy, blended as the shipped rules say or
 /// not at all.
@@ -38,6 +39,10 @@ fn over_whole_games_every_switch_is_drawn_under_the_bars() {
     ) = (0.0, 0.0, 0.0);
     let mut budget = game(true);
     budget.scenario.level_policy = LevelPolicy::Budget;
+    // A calibration kept for the tests: which switches the budget makes moves with the costs
+    // (the one of 2026-11-26 10:55 UTC made a rigid-to-hybrid switch drawn at 2.11 degrees).
+    budget.costs = load_file(&Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/it/fixtures/costs-measured.ron"))
+        .expect("the tests' cost model loads");
     let mut pops = Vec::new();
     let (mut switches, mut falls) = (0, 0);
     for config in [game(true), camera, collisions_only, budget] {
