@@ -320,7 +320,7 @@ fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
     tuned.camera.radius_m = 7.0;
     app.world_mut().resource_mut::<SimConfig>().rules = tuned.clone();
     app.world_mut().resource_mut::<BaseConfig>().rules = tuned;
-    let radii = |app: &mut App| running_and_next(app, |c| (c.rules.influence.puck_radius_m, c.rules.camera.radius_m));
+    let radii = |app: &App| running_and_next(app, |c| (c.rules.influence.puck_radius_m, c.rules.camera.radius_m));
 
     let file = root.join("game.ron");
     let text = std::fs::read_to_string(&file).unwrap();
@@ -328,11 +328,7 @@ fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
     update_until(&mut app, "the looks edit", |app| {
         app.world().resource::<GameSettings>().0 != looks
     });
-    assert_eq!(
-        radii(&mut app),
-        [(13.0, 7.0); 2],
-        "a looks edit keeps the player's radii"
-    );
+    assert_eq!(radii(&app), [(13.0, 7.0); 2], "a looks edit keeps the player's radii");
 
     let file = root.join("rules/levels.ron");
     let rules = std::fs::read_to_string(&file).unwrap();
@@ -341,7 +337,7 @@ fn a_looks_edit_keeps_the_players_radii_and_a_rules_edit_puts_back_the_files() {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
     assert_eq!(
-        radii(&mut app),
+        radii(&app),
         [(10.0, 12.0); 2],
         "a rules edit puts back the file's radii"
     );
@@ -439,7 +435,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     assert_eq!(looks.frame_budget.adaptive_frames, 30.0, "as shipped");
     app.insert_resource(GameSettings(looks.clone()));
     let_the_first_loads_settle(&mut app);
-    let adaptive = |app: &mut App| running_and_next(app, |c| c.rules.budget.adaptive_frames);
+    let adaptive = |app: &App| running_and_next(app, |c| c.rules.budget.adaptive_frames);
     // An edit of the rules (which leave the adaptive mode off) runs with the game's.
     let (rules_file, game_file) = (root.join("rules/levels.ron"), root.join("game.ron"));
     assert!(
@@ -451,13 +447,13 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
-    assert_eq!(adaptive(&mut app), [30.0; 2]);
+    assert_eq!(adaptive(&app), [30.0; 2]);
     // The game's setting edited: at once, running and for the next rounds.
     edit(&game_file, "adaptive_frames: 30.0", "adaptive_frames: 0.0");
     update_until(&mut app, "the game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 0.0
     });
-    assert_eq!(adaptive(&mut app), [0.0; 2]);
+    assert_eq!(adaptive(&app), [0.0; 2]);
     // Rules that set their own adaptive mode keep it whatever the game says.
     edit(&rules_file, "adaptive_frames: 0.0,", "adaptive_frames: 12.0,");
     update_until(&mut app, "the rules' own adaptive mode", |app| {
@@ -467,7 +463,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the second game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
     });
-    assert_eq!(adaptive(&mut app), [12.0; 2]);
+    assert_eq!(adaptive(&app), [12.0; 2]);
 }
 
 #[test]
@@ -482,21 +478,21 @@ fn the_costs_measured_at_start_up_stand_through_edits_of_the_rules_and_of_the_sc
     }
     let mut app = watching_app_overriding(&root, |_| {}, Some(measured.clone()));
     let_the_first_loads_settle(&mut app);
-    let costs = |app: &mut App| running_and_next(app, |c| c.costs.clone());
-    assert_eq!(costs(&mut app), [measured.clone(), measured.clone()]);
+    let costs = |app: &App| running_and_next(app, |c| c.costs.clone());
+    assert_eq!(costs(&app), [measured.clone(), measured.clone()]);
     // The rules edited: they apply, the measured model stays.
     edit(&root.join("rules/levels.ron"), "min_dwell_s: 0.5", "min_dwell_s: 0.4");
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
-    assert_eq!(costs(&mut app), [measured.clone(), measured.clone()]);
+    assert_eq!(costs(&app), [measured.clone(), measured.clone()]);
     // The scenario edited: a new round, by the measured model still.
     edit(&root.join("scenarios/default.ron"), "seed: 7,", "seed: 8,");
     update_until(&mut app, "the new round", |app| {
         app.world().resource::<Round>().number == 1
     });
     assert_eq!(app.world().resource::<BaseConfig>().scenario.seed, 8);
-    assert_eq!(costs(&mut app), [measured.clone(), measured]);
+    assert_eq!(costs(&app), [measured.clone(), measured]);
 }
 
 #[test]
