@@ -82,68 +82,91 @@ impl Candidate<'_> {
         if level == self.last { b * (1.0 + hysteresis) } else { b }
     }
 
+    /// Its levels priced for the knapsack, once a listing.
+    fn priced(&self, hysteresis: f32) -> Priced {
+        Priced {
+            cost_us: Lod::ALL.map(|l| self.cost_us(l)),
+            value: Lod::ALL.map(|l| self.value(l, hysteresis)),
+        }
+    }
+
     /// The next step up its upper hull of cost and benefit from `at`: the most benefit per
-    /// microsecond, ties to the lower level; none below `least_per_us`.
-    fn step_from(&self, creature: u32, at: Lod, hull: &Hull) -> Option<Step> {
-        let Hull {
-            hysteresis,
-            least_per_us,
-            ..
-        } = *hull;
-        let (cost, value) = (self.cost_us(at), self.value(at, hysteresis));
-        self.levels
-            .iter()
-            .copied()
-            .filter(|&l| l > at && self.value(l, hysteresis) > value)
-            .map(|to| {
-                let extra_us = self.cost_us(to) - cost;
-                let gain = self.value(to, hysteresis) - value;
-                let ratio = if extra_us > 0.0 { gain / extra_us } else { f32::INFINITY };
-                // Only the rigid benefit is ever a bound: a step to another level is exact.
-                let bound = !self.settled && to == Lod::Rigid;
-                Step {
-                    ratio,
-                    bound,
-                    serial: self.serial,
-                    creature,
-                    from: at,
-                    to,
-                    extra_us: if bound { self.cheapest_step_us(at) } else { extra_us },
-                    running_us: self.frame_cost_us(to) - self.frame_cost_us(at),
-                }
-            })
-            .max_by(|a, b| a.ratio.total_cmp(&b.ratio).then(b.to.cmp(&a.to)))
-            .filter(|s| s.ratio >= least_per_us)
+    /// microsecond, ties to the lower level; none below `least_per_us`. A loop over its levels,
+    /// each priced once in `p`: it is listed for every creature at every decision.
+    fn step_from(&self, creature: u32, at: Lod, hull: &Hull, p: &Priced) -> Option<Step> {
+        let (cost, value) = (p.cost_us[at as usize], p.value[at as usize]);
+        let (mut best, mut best_ratio) = (None, f32::NEG_INFINITY);
+        // After its search, only a step that gains can follow a bound.
+        let mut after_search_us = f32::INFINITY;
+        for &to in self.levels {
+            let (to_cost, to_value) = (p.cost_us[to as usize], p.value[to as usize]);
+            let gains = to > at && to_value > value;
+            if gains || (to > at && to == Lod::Rigid) {
+                after_search_us = after_search_us.min(to_cost - cost);
+            }
+            if !gains {
+                continue;
+            }
+            let extra_us = to_cost - cost;
+            let ratio = if extra_us > 0.0 {
+                (to_value - value) / extra_us
+            } else {
+                f32::INFINITY
+            };
+            let better = ratio
+                .total_cmp(&best_ratio)
+                .then(best.map_or(std::cmp::Ordering::Greater, |b: Lod| b.cmp(&to)));
+            if better.is_gt() {
+                (best, best_ratio) = (Some(to), ratio);
+            }
+        }
+        let to = best.filter(|_| best_ratio >= hull.least_per_us)?;
+        // Only the rigid benefit is ever a bound: a step to another level is exact.
+        let bound = !self.settled && to == Lod::Rigid;
+        let running = |l: Lod| p.cost_us[l.max(self.current) as usize];
+        Some(Step {
+            ratio: best_ratio,
+            bound,
+            serial: self.serial,
+            creature,
+            from: at,
+            to,
+            extra_us: if bound {
+                after_search_us
+            } else {
+                p.cost_us[to as usize] - cost
+            },
+            running_us: running(to) - running(at),
+        })
     }
 
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
-    fn list_hull(&self, creature: u32, hull: &Hull, listed: &mut Vec<Step>) {
-        let mut next = self.step_from(creature, self.floor, hull);
+    fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, listed: &mut Vec<Step>) {
+        let mut next = self.step_from(creature, self.floor, hull, p);
         while let Some(step) = next {
             listed.push(step);
-            next = self.step_from(creature, step.to, hull);
+            next = self.step_from(creature, step.to, hull, p);
         }
     }
 
     /// The least any step up from its floor or a level above can cost.
-    fn cheapest_step_above_floor_us(&self) -> f32 {
-        self.levels
-            .iter()
-            .filter(|&&l| l >= self.floor)
-            .map(|&l| self.cheapest_step_us(l))
-            .fold(f32::INFINITY, f32::min)
+    fn cheapest_step_above_floor_us(&self, p: &Priced) -> f32 {
+        let mut cheapest = f32::INFINITY;
+        for &from in self.levels.iter().filter(|&&l| l >= self.floor) {
+            for &to in self.levels.iter().filter(|&&l| l > from) {
+                cheapest = cheapest.min(p.cost_us[to as usize] - p.cost_us[from as usize]);
+            }
+        }
+        cheapest
     }
+}
 
-    /// The least any step up from `at` can cost.
-    fn cheapest_step_us(&self, at: Lod) -> f32 {
-        let from_us = self.cost_us(at);
-        self.levels
-            .iter()
-            .filter(|&&l| l > at)
-            .map(|&l| self.cost_us(l) - from_us)
-            .fold(f32::INFINITY, f32::min)
-    }
+/// A candidate's levels priced for the knapsack, by `Lod as usize`: what each costs (as
+/// `Candidate::cost_us`) and is worth (as `Candidate::value`).
+struct Priced {
+    cost_us: [f32; 3],
+    value: [f32; 3],
 }
 
 /// The levels chosen, and what the frame is predicted to cost.
@@ -260,10 +283,11 @@ pub fn allocate<S: Send>(
         rising &= c.costs.rise_with_level();
         levels.push(c.floor);
         settled_now.push(c.settled);
-        spent += c.cost_us(c.floor);
-        running_us += c.frame_cost_us(c.floor);
-        cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us());
-        c.list_hull(i as u32, &hull, &mut listed);
+        let p = c.priced(hull.hysteresis);
+        spent += p.cost_us[c.floor as usize];
+        running_us += p.cost_us[c.floor.max(c.current) as usize];
+        cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us(&p));
+        c.list_hull(i as u32, &hull, &p, &mut listed);
     }
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
@@ -278,8 +302,13 @@ pub fn allocate<S: Send>(
     let mut need_from = vec![(f32::INFINITY, f32::INFINITY); listed.len() + 1];
     for (i, step) in listed.iter().enumerate().rev() {
         let (any, exact) = need_from[i + 1];
-        let exact_need = if step.bound { f32::INFINITY } else { step.extra_us };
-        need_from[i] = (any.min(step.extra_us), exact.min(exact_need));
+        // A bound needs room for its search too.
+        let (any_need, exact_need) = if step.bound {
+            (settle_us + step.extra_us, f32::INFINITY)
+        } else {
+            (step.extra_us, step.extra_us)
+        };
+        need_from[i] = (any.min(any_need), exact.min(exact_need));
     }
     let mut next = 0;
     let mut follows = Follows::default();
@@ -332,7 +361,8 @@ pub fn allocate<S: Send>(
             taken.push(step);
             // A listed step's successor is listed too.
             if followed {
-                follows.push(candidates[creature].step_from(step.creature, step.to, &hull));
+                let c = &candidates[creature];
+                follows.push(c.step_from(step.creature, step.to, &hull, &c.priced(hull.hysteresis)));
             }
         }
     }
@@ -472,7 +502,7 @@ impl<S: Send> SettledAhead<S> {
                         let mut c = candidates[step.creature as usize].clone();
                         c.benefit[Lod::Rigid as usize] = benefit;
                         c.settled = true;
-                        let step = c.step_from(step.creature, step.from, hull);
+                        let step = c.step_from(step.creature, step.from, hull, &c.priced(hull.hysteresis));
                         *m = Some(Settled { benefit, kept, step });
                     }
                 }
@@ -515,7 +545,7 @@ impl From<&Candidate<'_>> for AtFloor {
             floor: c.floor,
             cost_us: c.cost_us(c.floor),
             frame_us: c.frame_cost_us(c.floor),
-            cheapest_step_us: c.cheapest_step_above_floor_us(),
+            cheapest_step_us: c.cheapest_step_above_floor_us(&c.priced(0.0)),
         }
     }
 }
