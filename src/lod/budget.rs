@@ -733,6 +733,9 @@ struct Scene<'a> {
     top_speed: f32,
     /// How far away another creature can still matter.
     reach_m: f32,
+    /// The latest times at which the puck or an area, and a wall, can be worth as much as a
+    /// contact with another creature ([`outweigh_times_s`]).
+    outweigh_creature_s: ([f32; 2], [f32; 2]),
 }
 
 impl Scene<'_> {
@@ -743,26 +746,46 @@ impl Scene<'_> {
         decay(-t_course / h).max(self.rules.worst_case_share * decay(-t_worst / h))
     }
 
-    /// How urgent a contact is with a circle of `circle_radius` at `centre` moving at `velocity`.
-    fn circle(&self, s: &PlanarState, radius: f32, centre: Vec2, velocity: Vec2, circle_radius: f32) -> f32 {
+    /// When a contact could come with a circle of `circle_radius` at `centre` moving at
+    /// `velocity`.
+    fn circle(&self, s: &PlanarState, radius: f32, centre: Vec2, velocity: Vec2, circle_radius: f32) -> ContactTimes {
         let d = s.position - centre;
         let reach = radius + circle_radius + self.rules.contact_margin_m;
         let gap = (d.length() - reach).max(0.0);
         let closing = self.top_speed + velocity.length();
-        let t = time_to_contact(d, s.velocity - velocity, reach);
-        self.urgency(t, gap / closing.max(1e-3))
+        ContactTimes {
+            course_s: time_to_contact(d, s.velocity - velocity, reach),
+            worst_s: gap / closing.max(1e-3),
+        }
     }
 
-    /// How urgent a contact is with the puck, the host's areas or a wall (the rigid level's
-    /// benefit from contacts, before other creatures are searched).
-    fn near(&self, s: &PlanarState, radius: f32) -> f32 {
-        let (r, margin) = (self.rules, self.rules.contact_margin_m);
-        let mut best = 0.0f32;
+    /// How urgent the contacts with the puck, the host's areas and the walls are, weighed (the
+    /// rigid level's benefit from contacts, before other creatures are searched).
+    fn near_benefit(&self, near: &Near) -> f32 {
+        let r = self.rules;
+        let weighed = |weight: f32, t: ContactTimes| weight * self.urgency(t.course_s, t.worst_s);
+        weighed(r.puck_weight, near.puck).max(weighed(r.wall_weight, near.wall))
+    }
+
+    /// Whether the puck, the areas or the walls could be worth as much as a contact with
+    /// another creature now: tested on the times, against [`Scene::outweigh_creature_s`], with
+    /// no exponential worked out (most of a crowd is too far).
+    fn may_outweigh_a_creature(&self, near: &Near) -> bool {
+        let ([puck_course, puck_worst], [wall_course, wall_worst]) = self.outweigh_creature_s;
+        near.puck.course_s <= puck_course
+            || near.puck.worst_s <= puck_worst
+            || near.wall.course_s <= wall_course
+            || near.wall.worst_s <= wall_worst
+    }
+
+    /// How soon a contact could come with the puck, the host's areas or a wall.
+    fn near(&self, s: &PlanarState, radius: f32) -> Near {
+        let margin = self.rules.contact_margin_m;
         // The puck, and the host's areas of influence.
         let puck = self.puck;
-        best = best.max(r.puck_weight * self.circle(s, radius, puck.position, puck.velocity, puck.radius_m));
+        let mut soonest = self.circle(s, radius, puck.position, puck.velocity, puck.radius_m);
         for a in &self.areas {
-            best = best.max(r.puck_weight * self.circle(s, radius, a.position, a.velocity, a.radius_m));
+            soonest = soonest.sooner(self.circle(s, radius, a.position, a.velocity, a.radius_m));
         }
         // The walls: the nearest on each axis.
         let room = self.court.half_extents - Vec2::splat(radius + margin) - s.position.abs();
@@ -776,9 +799,14 @@ impl Scene<'_> {
                 f32::INFINITY
             }
         };
-        let t = course(room.x, along.x).min(course(room.y, along.y));
         let gap = room.min_element().max(0.0);
-        best.max(r.wall_weight * self.urgency(t, gap / self.top_speed.max(1e-3)))
+        Near {
+            puck: soonest,
+            wall: ContactTimes {
+                course_s: course(room.x, along.x).min(course(room.y, along.y)),
+                worst_s: gap / self.top_speed.max(1e-3),
+            },
+        }
     }
 
     /// How urgent the soonest contact with another creature is (0 to 1).
@@ -844,25 +872,74 @@ impl Scene<'_> {
     }
 }
 
+/// How soon a contact could come: on the present courses, and at the earliest, s.
+#[derive(Clone, Copy, Debug, Default)]
+struct ContactTimes {
+    course_s: f32,
+    worst_s: f32,
+}
+
+impl ContactTimes {
+    fn sooner(self, other: Self) -> Self {
+        Self {
+            course_s: self.course_s.min(other.course_s),
+            worst_s: self.worst_s.min(other.worst_s),
+        }
+    }
+}
+
+/// How soon a creature could meet the puck or one of the host's areas (weighed alike), and a
+/// wall. Urgency falls with time, so the soonest of each weight is all that counts.
+#[derive(Clone, Copy, Debug, Default)]
+struct Near {
+    puck: ContactTimes,
+    wall: ContactTimes,
+}
+
+/// The latest times, on the course and at the earliest, at which a contact weighed `weight`
+/// can still be worth `creature_weight` (urgency `e^(-t/horizon)`, the worst case at its
+/// share), widened a little so that rounding never leaves out one that is: the test only
+/// spares the exponentials, and what passes it is weighed exactly.
+fn outweigh_times_s(rules: &BudgetRules, weight: f32) -> [f32; 2] {
+    let latest = |worth: f32| {
+        if rules.creature_weight <= 0.0 {
+            f32::INFINITY
+        } else if worth <= 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            let t = rules.contact_horizon_s * (worth / rules.creature_weight).ln();
+            t + t.abs() * 1e-3 + 1e-3
+        }
+    };
+    [latest(weight), latest(weight * rules.worst_case_share)]
+}
+
 /// One creature's benefits before its search for contacts with other creatures.
 #[derive(Clone, Copy, Debug, Default)]
 struct Bounds {
     hybrid: f32,
     /// The rigid level's benefit from the view and the player.
     seen: f32,
-    /// The rigid level's from the puck, the areas and the walls.
-    near: f32,
+    /// How soon the puck, an area or a wall could be met.
+    near: Near,
 }
 
 impl Bounds {
-    /// The rigid level's benefit with contacts with other creatures at `crowding`.
-    fn rigid(&self, rules: &BudgetRules, crowding: f32) -> f32 {
-        self.seen + self.near.max(rules.creature_weight * crowding)
+    /// The rigid level's benefit with contacts with other creatures at `crowding`. The puck,
+    /// the areas and the walls are weighed only where they could outweigh those contacts.
+    fn rigid(&self, scene: &Scene, crowding: f32) -> f32 {
+        let creatures = scene.rules.creature_weight * crowding;
+        let near = if crowding >= 1.0 && !scene.may_outweigh_a_creature(&self.near) {
+            0.0
+        } else {
+            scene.near_benefit(&self.near)
+        };
+        self.seen + near.max(creatures)
     }
 
     /// Whether no other creature can change the rigid level's benefit.
-    fn settled(&self, rules: &BudgetRules) -> bool {
-        self.near >= rules.creature_weight
+    fn settled(&self, scene: &Scene) -> bool {
+        scene.may_outweigh_a_creature(&self.near) && scene.near_benefit(&self.near) >= scene.rules.creature_weight
     }
 }
 
@@ -982,8 +1059,8 @@ fn decide(
                         // A search within `contact_recheck_s` stands; without one, any
                         // contact with another creature could be now.
                         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
-                        candidate.benefit = [0.0, bound.hybrid, bound.rigid(rules, standing.map_or(1.0, |s| s.0))];
-                        candidate.settled = standing.is_some() || bound.settled(rules);
+                        candidate.benefit = [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))];
+                        candidate.settled = standing.is_some() || bound.settled(scene);
                     }
                 }
             }),
@@ -993,7 +1070,7 @@ fn decide(
     let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, search_us, |i| {
         let (_, c, _, s, _) = rows[i];
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
-        (bounds[i].rigid(rules, urgency), urgency)
+        (bounds[i].rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(candidates.len());
@@ -1022,6 +1099,10 @@ fn scene<'a>(
         top_speed,
         // Beyond three horizons at both creatures' top speeds, a contact is worth under 5 %.
         reach_m: 2.0 * biggest + rules.contact_margin_m + 2.0 * top_speed * 3.0 * rules.contact_horizon_s,
+        outweigh_creature_s: (
+            outweigh_times_s(rules, rules.puck_weight),
+            outweigh_times_s(rules, rules.wall_weight),
+        ),
     }
 }
 
