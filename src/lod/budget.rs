@@ -1456,6 +1456,28 @@ mod tests {
         );
     }
 
+    /// A scene with no host areas, creatures at most 3 m/s.
+    fn test_scene<'a>(
+        b: &'a BudgetRules,
+        puck: &'a PuckState,
+        court: &'a Court,
+        grid: &'a NeighbourGrid,
+        camera: &'a SimCamera,
+        reach_m: f32,
+    ) -> Scene<'a> {
+        Scene {
+            rules: b,
+            puck,
+            areas: Vec::new(),
+            court,
+            grid,
+            camera,
+            top_speed: 3.0,
+            reach_m,
+            outweigh_creature_s: (outweigh_times_s(b, b.puck_weight), outweigh_times_s(b, b.wall_weight)),
+        }
+    }
+
     #[test]
     fn the_nearest_first_search_finds_the_same_soonest_contact_as_the_whole_reach() {
         let mut rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
@@ -1502,16 +1524,8 @@ mod tests {
             SimCamera::default(),
         );
         let top_speed = 3.0;
-        let scene = Scene {
-            rules: b,
-            puck: &puck,
-            areas: Vec::new(),
-            court: &court,
-            grid: &grid,
-            camera: &camera,
-            top_speed,
-            reach_m: 0.7 + b.contact_margin_m + 2.0 * top_speed * 3.0 * b.contact_horizon_s,
-        };
+        let reach_m = 0.7 + b.contact_margin_m + 2.0 * top_speed * 3.0 * b.contact_horizon_s;
+        let scene = test_scene(b, &puck, &court, &grid, &camera, reach_m);
         let mut with_neighbours = 0;
         for (c, s) in &creatures {
             let (mut t_course, mut t_worst, mut seen) = (f32::INFINITY, f32::INFINITY, 0);
@@ -1534,6 +1548,55 @@ mod tests {
             with_neighbours += usize::from(seen > 0);
         }
         assert!(with_neighbours > 2800);
+    }
+
+    #[test]
+    fn the_puck_and_the_walls_weighed_only_where_they_could_outweigh_a_creature_give_the_same_benefits() {
+        let rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
+        let b = &rules.budget;
+        let half = Vec2::new(80.0, 50.0);
+        let puck = PuckState {
+            position: Vec2::new(10.0, -5.0),
+            velocity: Vec2::new(4.0, 3.0),
+            radius_m: 2.0,
+        };
+        let (court, camera, grid) = (
+            Court { half_extents: half },
+            SimCamera::default(),
+            NeighbourGrid::new(half, 1.6),
+        );
+        let scene = test_scene(b, &puck, &court, &grid, &camera, 30.0);
+        let mut seed = 7u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut spared, mut weighed) = (0, 0);
+        for _ in 0..20_000 {
+            let s = PlanarState {
+                position: (Vec2::new(next(), next()) * 2.0 - Vec2::ONE) * half,
+                velocity: Vec2::from_angle(next() * std::f32::consts::TAU) * 3.0 * next(),
+                ..default()
+            };
+            let bounds = Bounds {
+                hybrid: 0.0,
+                seen: next(),
+                near: scene.near(&s, 0.35),
+            };
+            let near = scene.near_benefit(&bounds.near);
+            for crowding in [1.0, 0.6, 0.0] {
+                let exact = bounds.seen + near.max(b.creature_weight * crowding);
+                assert_eq!(bounds.rigid(&scene, crowding), exact, "{s:?} at {crowding}");
+            }
+            assert_eq!(bounds.settled(&scene), near >= b.creature_weight, "{s:?}");
+            if scene.may_outweigh_a_creature(&bounds.near) {
+                weighed += 1;
+            } else {
+                spared += 1;
+            }
+        }
+        // Both sides of the test are exercised: most creatures are spared the weighing.
+        assert!(spared > weighed && weighed > 100, "{spared} spared, {weighed} weighed");
     }
 
     #[test]
