@@ -215,11 +215,13 @@ impl Ord for Step {
 
 impl Step {
     /// The same order as a key, smallest first, short of the level: steps sorted by it stably,
-    /// in the order of each creature's hull, are in [`Ord`]'s order.
-    fn order_key(&self) -> u64 {
-        let bits = self.ratio.to_bits();
-        let ascending = if bits >> 31 == 1 { !bits } else { bits | 0x8000_0000 };
-        (u64::from(!ascending) << 32) | u64::from(self.serial)
+    /// in the order of each creature's hull, are in [`Ord`]'s order. A ratio is never negative
+    /// (a step gains), so its sign is left out, and the serial takes only the `serial_bits` the
+    /// largest serial needs: the radix sort passes over fewer bytes.
+    fn order_key(&self, serial_bits: u32) -> u64 {
+        debug_assert!(self.ratio.is_sign_positive() && !self.ratio.is_nan(), "{}", self.ratio);
+        let descending = 0x7FFF_FFFF - (self.ratio.to_bits() & 0x7FFF_FFFF);
+        (u64::from(descending) << serial_bits) | u64::from(self.serial)
     }
 }
 
@@ -279,8 +281,10 @@ pub fn allocate<S: Send>(
     // Where every level costs no less than the one below, what is spent and the frame as it
     // will run only grow, so a step that cannot fit now never will and may be passed by.
     let mut rising = true;
+    let mut most_serial = 0;
     for (i, c) in candidates.iter().enumerate() {
         rising &= c.costs.rise_with_level();
+        most_serial = most_serial.max(c.serial);
         levels.push(c.floor);
         settled_now.push(c.settled);
         let p = c.priced(hull.hysteresis);
@@ -292,7 +296,8 @@ pub fn allocate<S: Send>(
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
     if spent + cheapest_us <= budget_us {
-        radsort::sort_by_key(&mut listed, Step::order_key);
+        let serial_bits = u32::BITS - most_serial.leading_zeros();
+        radsort::sort_by_key(&mut listed, |s| s.order_key(serial_bits));
     } else {
         listed.clear();
     }
@@ -1597,6 +1602,41 @@ mod tests {
         }
         // Both sides of the test are exercised: most creatures are spared the weighing.
         assert!(spared > weighed && weighed > 100, "{spared} spared, {weighed} weighed");
+    }
+
+    #[test]
+    fn steps_sorted_by_their_key_are_in_the_order_they_are_taken() {
+        let mut seed = 3u64;
+        let mut next = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let ratios = [0.0, 1e-30, 0.006, 0.5, 7.0, f32::INFINITY];
+        for most_serial in [5u32, 1000, 100_000, u32::MAX] {
+            let mut steps: Vec<Step> = (0..4000)
+                .map(|_| {
+                    // Many equal ratios, as a crowd's unsearched bounds have.
+                    let ratio = if next() < 0.5 {
+                        ratios[(next() * 6.0) as usize]
+                    } else {
+                        next() * 10.0
+                    };
+                    Step {
+                        ratio,
+                        bound: false,
+                        serial: (next() * most_serial as f32) as u32,
+                        creature: 0,
+                        from: Lod::PointMass,
+                        to: Lod::Rigid,
+                        extra_us: 1.0,
+                        running_us: 1.0,
+                    }
+                })
+                .collect();
+            let serial_bits = u32::BITS - most_serial.leading_zeros();
+            radsort::sort_by_key(&mut steps, |s| s.order_key(serial_bits));
+            assert!(steps.windows(2).all(|w| w[0] >= w[1]), "up to serial {most_serial}");
+        }
     }
 
     #[test]
