@@ -57,11 +57,18 @@ pub struct CrowdShares {
     pub point_mass: f32,
     /// Of the hybrid level's cost.
     pub hybrid: f32,
+    /// Of the budget policy's choice per creature (a file without it: 1).
+    #[serde(default = "CrowdShares::whole")]
+    pub choice: f32,
 }
 
 impl CrowdShares {
     fn first_measured_at() -> u32 {
         16_384
+    }
+
+    fn whole() -> f32 {
+        1.0
     }
 }
 
@@ -127,23 +134,24 @@ impl CostModel {
     /// Predicted microseconds of a frame of `creatures` before any creature's level: the
     /// fixed cost and the budget policy's choice.
     pub fn overhead_us(&self, creatures: usize) -> f32 {
-        self.fixed_us_per_frame + self.decision_us_per_creature * creatures as f32
+        let share = self.shares_in_crowd(creatures as u32).map_or(1.0, |s| s.choice);
+        self.fixed_us_per_frame + self.decision_us_per_creature * share * creatures as f32
     }
 
     /// The costs of the kind named `kind` in a world of `creatures`: in a crowd, the cheap
     /// levels at their crowd shares.
     pub fn in_crowd(&self, kind: &str, creatures: u32) -> LevelCosts {
         let mut costs = *self.of(kind);
-        if let Some((point_mass, hybrid)) = self.shares_in_crowd(creatures) {
-            costs.point_mass_us_per_frame *= point_mass;
-            costs.hybrid_us_per_frame *= hybrid;
+        if let Some(shares) = self.shares_in_crowd(creatures) {
+            costs.point_mass_us_per_frame *= shares.point_mass;
+            costs.hybrid_us_per_frame *= shares.hybrid;
         }
         costs
     }
 
     /// The cheap levels' shares in a world of `creatures` (see `larger_crowd_shares`): none
     /// short of a crowd.
-    fn shares_in_crowd(&self, creatures: u32) -> Option<(f32, f32)> {
+    fn shares_in_crowd(&self, creatures: u32) -> Option<CrowdShares> {
         let first = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES)?;
         let measured = std::iter::once(&first).chain(&self.larger_crowd_shares);
         let (mut below, n) = (first, creatures as f32);
@@ -156,11 +164,16 @@ impl CostModel {
                     1.0
                 };
                 let at = |b: f32, a: f32| b + (a - b) * t;
-                return Some((at(below.point_mass, above.point_mass), at(below.hybrid, above.hybrid)));
+                return Some(CrowdShares {
+                    creatures,
+                    point_mass: at(below.point_mass, above.point_mass),
+                    hybrid: at(below.hybrid, above.hybrid),
+                    choice: at(below.choice, above.choice),
+                });
             }
             below = *above;
         }
-        Some((below.point_mass, below.hybrid))
+        Some(CrowdShares { creatures, ..below })
     }
 
     /// The costs of the kind named `kind`.
@@ -200,6 +213,7 @@ impl Validate for CostModel {
             );
             v.within("point_mass", shares.point_mass, 0.01, 10.0);
             v.within("hybrid", shares.hybrid, 0.01, 10.0);
+            v.within("choice", shares.choice, 0.01, 10.0);
         };
         if let Some(first) = &self.crowd_shares {
             v.nested("crowd_shares", |v| {
@@ -273,9 +287,19 @@ mod tests {
     fn a_crowd_between_two_measured_takes_a_share_between_theirs_on_the_logarithm_of_its_count() {
         let text = format!(
             "(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((creatures: 4096, point_mass: 1.0, hybrid: 1.0)), \
-             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75)])"
+             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75, choice: 0.5)])"
         );
-        let model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
+        let mut model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
+        // The choice's share too (a share left out is 1): none short of a crowd.
+        (model.fixed_us_per_frame, model.decision_us_per_creature) = (0.0, 2.0);
+        assert_eq!(model.overhead_us(100), 200.0);
+        assert_eq!(model.overhead_us(16_384), 2.0 * 16_384.0);
+        assert!(
+            (model.overhead_us(32_768) - 0.75 * 2.0 * 32_768.0).abs() < 1.0,
+            "{}",
+            model.overhead_us(32_768)
+        );
+        assert_eq!(model.overhead_us(1_000_000), 0.5 * 2.0 * 1e6);
         let point_mass = |n| model.in_crowd("hopper", n).point_mass_us_per_frame;
         // The smallest crowd's share down to the smallest crowd, the largest's beyond it.
         assert_eq!(point_mass(PARALLEL_MIN_CREATURES), 1.0);

@@ -358,7 +358,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         crowd_shares: None,
         larger_crowd_shares: Vec::new(),
     };
-    let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, warmup, frames);
+    let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, (warmup, frames), true);
     (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
     if how == Calibration::AtStartUp {
         model.crowd_shares = config.costs.crowd_shares;
@@ -381,12 +381,23 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
             .collect()
     };
     let (point_mass, hybrid) = (shares(LevelPolicy::AllPointMass), shares(LevelPolicy::AllHybrid));
-    let mut measured =
-        (crowds.iter().zip(point_mass.iter().zip(&hybrid))).map(|(&creatures, (&point_mass, &hybrid))| CrowdShares {
+    // The choice's too: in a crowd its per-creature work runs across the cores, and most of
+    // its listing and sorting is by creature, not by search.
+    let choice_us = |count| choice_cost_us(config, &model, count, (warmup, frames.div_ceil(3)), false).0;
+    let choice: Vec<f32> = {
+        let alone = choice_us(cheap_count).max(1e-9);
+        (crowds.iter())
+            .map(|&count| (choice_us(count) / alone).clamp(0.01, 10.0) as f32)
+            .collect()
+    };
+    let mut measured = (crowds.iter().zip(point_mass.iter().zip(&hybrid)).zip(&choice)).map(
+        |((&creatures, (&point_mass, &hybrid)), &choice)| CrowdShares {
             creatures,
             point_mass,
             hybrid,
-        });
+            choice,
+        },
+    );
     model.crowd_shares = measured.next();
     model.larger_crowd_shares = measured.collect();
     model
@@ -406,6 +417,7 @@ fn median_model(models: &[CostModel]) -> CostModel {
         creatures: shares(&models[0]).creatures,
         point_mass: median_of(&|m| shares(m).point_mass),
         hybrid: median_of(&|m| shares(m).hybrid),
+        choice: median_of(&|m| shares(m).choice),
     };
     let first = &models[0];
     let mut model = CostModel {
@@ -445,7 +457,13 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
 /// with room for every creature's every step (so nothing is left out): the microseconds per
 /// creature without the search for contacts between creatures (the creatures' weight at 0,
 /// so none needs it), and the microseconds per creature searched.
-fn choice_cost_us(config: &SimConfig, model: &CostModel, count: u32, warmup: usize, calls: usize) -> (f64, f64) {
+fn choice_cost_us(
+    config: &SimConfig,
+    model: &CostModel,
+    count: u32,
+    (warmup, calls): (usize, usize),
+    with_searches: bool,
+) -> (f64, f64) {
     let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
     for _ in 0..warmup {
         sim.advance_frame();
@@ -468,6 +486,9 @@ fn choice_cost_us(config: &SimConfig, model: &CostModel, count: u32, warmup: usi
         (us, searched)
     };
     let (unsearched_us, _) = time_choice(0.0);
+    if !with_searches {
+        return (unsearched_us / f64::from(count.max(1)), 0.0);
+    }
     let (searched_us, searched) = time_choice(config.rules.budget.creature_weight);
     (
         unsearched_us / f64::from(count.max(1)),
@@ -513,8 +534,8 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
     ));
     for shares in model.crowd_shares.iter().chain(&model.larger_crowd_shares) {
         lines.push(format!(
-            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}",
-            shares.creatures, shares.point_mass, shares.hybrid
+            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}, the choice x {:.2}",
+            shares.creatures, shares.point_mass, shares.hybrid, shares.choice
         ));
     }
     lines
