@@ -1461,6 +1461,28 @@ mod tests {
         );
     }
 
+    #[test]
+    fn a_creature_is_searched_only_with_room_for_the_search_and_a_step_that_can_follow_it() {
+        // Out of view: nothing gained at the hybrid level, so after its search only the rigid
+        // step could follow (149 us from its point mass, the building of its bodies with it).
+        // A creature in view beside it takes its hybrid step (1 us) first.
+        let unseen = Candidate {
+            benefit: [0.0, 0.0, 2.0],
+            settled: false,
+            ..candidate(0, Lod::PointMass, 2.0)
+        };
+        let seen = candidate(1, Lod::PointMass, 0.0);
+        let crowd = [unseen, seen];
+        // The point masses cost 2 us, the hybrid step 1, the search 1.
+        for (budget_us, searched) in [(60.0, false), (152.0, false), (153.0, true), (400.0, true)] {
+            let a = allocate(&mut crowd.clone(), budget_us, 0.0, 0.0, 1.0, |_| (1.5, ()));
+            assert_eq!(!a.settled.is_empty(), searched, "{budget_us} us: {a:?}");
+            assert_eq!(a.levels[1], Lod::Hybrid, "{budget_us} us");
+            let rigid = if budget_us >= 153.0 { Lod::Rigid } else { Lod::PointMass };
+            assert_eq!(a.levels[0], rigid, "{budget_us} us");
+        }
+    }
+
     /// A scene with no host areas, creatures at most 3 m/s.
     fn test_scene<'a>(
         b: &'a BudgetRules,
