@@ -30,9 +30,9 @@ pub struct CostModel {
     /// still buy a level are). A file without it predicts 0.
     #[serde(default)]
     pub contact_search_us: f32,
-    /// What the point-mass and hybrid levels cost per creature in a crowd, where they are
-    /// stepped across the cores, as shares of the figures above (measured on one thread): at
-    /// the smallest crowd measured. A file without it predicts a crowd at those figures.
+    /// What the point-mass and hybrid levels and the choice cost per creature in a crowd, where
+    /// they run across the cores, as shares of the figures above (measured on one thread, the
+    /// choice at 2,000 creatures): at the smallest crowd measured. A file without it predicts a crowd at those figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_shares: Option<CrowdShares>,
     /// The same shares measured at larger crowds, smallest first: a crowd's share is
@@ -132,7 +132,7 @@ impl LevelCosts {
 
 impl CostModel {
     /// Predicted microseconds of a frame of `creatures` before any creature's level: the
-    /// fixed cost and the budget policy's choice.
+    /// fixed cost and the budget policy's choice (in a crowd, at its share).
     pub fn overhead_us(&self, creatures: usize) -> f32 {
         let share = self.shares_in_crowd(creatures as u32).map_or(1.0, |s| s.choice);
         self.fixed_us_per_frame + self.decision_us_per_creature * share * creatures as f32
@@ -149,8 +149,8 @@ impl CostModel {
         costs
     }
 
-    /// The cheap levels' shares in a world of `creatures` (see `larger_crowd_shares`): none
-    /// short of a crowd.
+    /// The cheap levels' and the choice's shares in a world of `creatures` (see
+    /// `larger_crowd_shares`): none short of a crowd.
     fn shares_in_crowd(&self, creatures: u32) -> Option<CrowdShares> {
         let first = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES)?;
         let measured = std::iter::once(&first).chain(&self.larger_crowd_shares);

@@ -456,7 +456,7 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
 /// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up,
 /// with room for every creature's every step (so nothing is left out): the microseconds per
 /// creature without the search for contacts between creatures (the creatures' weight at 0,
-/// so none needs it), and the microseconds per creature searched.
+/// so none needs it), and, `with_searches`, the microseconds per creature searched (else 0).
 fn choice_cost_us(
     config: &SimConfig,
     model: &CostModel,
