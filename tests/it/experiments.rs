@@ -603,6 +603,23 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         "{said}"
     );
     assert!(said.contains("of 8 games"), "{said}");
+    // Each game's mean over its prediction, in its row in the games' order, and how many were
+    // within 10 % of it either way.
+    let reported: Vec<f64> = (said.lines())
+        .filter(|l| l.starts_with("| 30 |") || l.starts_with("| 90 |"))
+        .map(|l| l.split('|').nth(7).unwrap().trim().parse().unwrap())
+        .collect();
+    let mut honest = 0;
+    for (r, reported) in rows[1..].iter().zip(&reported) {
+        let ratio = r[4].parse::<f64>().unwrap() / r[6].parse::<f64>().unwrap();
+        assert!((reported - ratio).abs() < 0.006, "{reported} for {r:?}");
+        honest += usize::from((ratio - 1.0).abs() <= 0.1);
+    }
+    assert_eq!(reported.len(), 8, "{said}");
+    assert!(
+        said.contains(&format!("within 10 % of its prediction in {honest}.")),
+        "{said}"
+    );
     // Sizes out of order are refused with the field named.
     std::fs::write(
         &file,

@@ -81,6 +81,18 @@ impl Game {
     fn kept(&self) -> bool {
         self.mean_frame_ms <= 1.1 * f64::from(self.budget_ms) && self.p99_frame_ms <= 1.25 * f64::from(self.budget_ms)
     }
+
+    /// The mean frame measured over the cost model's prediction of it (the prediction can be
+    /// well under the budget: the choice buys no level worth less than its least benefit per
+    /// microsecond, and none above a creature's dearest).
+    fn measured_over_predicted(&self) -> f64 {
+        self.mean_frame_ms / self.predicted_mean_ms
+    }
+
+    /// Whether the prediction was honest: the mean frame within 10 % of it, either way.
+    fn predicted_within_10_percent(&self) -> bool {
+        (self.measured_over_predicted() - 1.0).abs() <= 0.1
+    }
 }
 
 fn game(config: &SimConfig, s: &BudgetScaleSettings, creatures: u32, budget_ms: f32, adaptive_frames: f32) -> Game {
@@ -216,15 +228,16 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
          the court grown with the count to the default game's density. Every frame's simulation timed on this machine's cores. \
          The budget is kept where the mean frame is within 10 % of it and the 99th percentile within 25 %: a game is {frames} frames, \
          and its 99th percentile is {p99_is}. \
+         Measured / predicted: the mean frame over the cost model's prediction of it, honest within 10 % either way. \
          Over budget: the decisions where even the cheapest levels were predicted over it.\n\n\
-         | creatures | budget (ms) | adaptive | mean frame (ms) | 99th percentile (ms) | predicted (ms) | kept | over budget | hybrid | rigid |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n",
+         | creatures | budget (ms) | adaptive | mean frame (ms) | 99th percentile (ms) | predicted (ms) | measured / predicted | kept | over budget | hybrid | rigid |\n\
+         |---|---|---|---|---|---|---|---|---|---|---|\n",
         s.seed, s.seconds
     );
     for g in games {
         let _ = writeln!(
             report,
-            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {} of {} | {:.0} | {:.0} |",
+            "| {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} of {} | {:.0} | {:.0} |",
             g.creatures,
             g.budget_ms,
             if g.adaptive_frames > 0.0 {
@@ -235,6 +248,7 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
             g.mean_frame_ms,
             g.p99_frame_ms,
             g.predicted_mean_ms,
+            g.measured_over_predicted(),
             if g.kept() { "yes" } else { "no" },
             g.decisions_over_budget,
             g.decisions,
@@ -243,6 +257,11 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
         );
     }
     let kept = games.iter().filter(|g| g.kept()).count();
-    let _ = write!(report, "\nKept in {kept} of {} games.\n", games.len());
+    let honest = games.iter().filter(|g| g.predicted_within_10_percent()).count();
+    let _ = write!(
+        report,
+        "\nKept in {kept} of {} games; the mean frame within 10 % of its prediction in {honest}.\n",
+        games.len()
+    );
     report
 }
