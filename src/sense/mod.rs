@@ -43,6 +43,19 @@ pub struct Neighbour {
     pub serial: u32,
 }
 
+/// A creature in the index, and its cell (`row * cols + column`) beside it: a query reads
+/// both from one line of the cache (32 bytes), where two arrays missed it twice in a crowd.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    neighbour: Neighbour,
+    cell: u32,
+}
+
+const _: () = assert!(
+    std::mem::size_of::<Entry>() == 32,
+    "an entry fills half a line of the cache"
+);
+
 /// Cells per block along a row: the index keeps where each block's entries start, not each
 /// cell's, so a rebuild clears and sums an eighth of the cells (23 cells a creature at the
 /// shipped density: the cells, not the creatures, were most of a rebuild and of the memory).
@@ -60,9 +73,7 @@ pub struct NeighbourGrid {
     /// `block_start[b]..block_start[b + 1]` are the entries of block `b` (row by row), in the
     /// order of their cells, and in input order within a cell.
     block_start: Vec<u32>,
-    entries: Vec<Neighbour>,
-    /// Each entry's cell (`row * cols + column`).
-    entry_cell: Vec<u32>,
+    entries: Vec<Entry>,
     /// Scratch, kept to avoid an allocation per rebuild: each input's block and cell.
     keys: Vec<(u32, u32)>,
     scratch: Vec<Neighbour>,
@@ -186,35 +197,38 @@ impl NeighbourGrid {
         // Range r fills the entries from where its first block starts, its cursors
         // `block_start[edge[r] + 1..edge[r + 1] + 1]`. Every slot is written, so the arrays are
         // only resized (not cleared and filled first: a pass of its own).
-        self.entries.resize(len, EMPTY);
-        self.entry_cell.resize(len, 0);
+        self.entries.resize(
+            len,
+            Entry {
+                neighbour: EMPTY,
+                cell: 0,
+            },
+        );
         let starts: Vec<usize> = (edge
             .iter()
             .map(|&b| self.block_start.get(b + 1).map_or(len, |&s| s as usize)))
         .collect();
         let (items, keys) = (&self.scratch, &self.keys);
         let mut fills = Vec::with_capacity(ranges);
-        let (mut entries, mut cells) = (&mut self.entries[..], &mut self.entry_cell[..]);
+        let mut entries = &mut self.entries[..];
         let mut cursors = &mut self.block_start[1..];
         for r in 0..ranges {
             let size = starts[r + 1] - starts[r];
             let (mine, more) = std::mem::take(&mut entries).split_at_mut(size);
-            let (mine_cells, more_cells) = std::mem::take(&mut cells).split_at_mut(size);
             let (mine_cursors, more_cursors) = std::mem::take(&mut cursors).split_at_mut(edge[r + 1] - edge[r]);
-            fills.push((edge[r], starts[r], mine, mine_cells, mine_cursors));
-            (entries, cells, cursors) = (more, more_cells, more_cursors);
+            fills.push((edge[r], starts[r], mine, mine_cursors));
+            (entries, cursors) = (more, more_cursors);
         }
-        run_chunks(fills.into_iter().map(|(first, start, entries, cells, cursors)| {
+        run_chunks(fills.into_iter().map(|(first, start, entries, cursors)| {
             move || {
-                for (n, &(b, c)) in items.iter().zip(keys) {
+                for (&neighbour, &(b, cell)) in items.iter().zip(keys) {
                     if let Some(slot) = (b as usize).checked_sub(first).and_then(|i| cursors.get_mut(i)) {
-                        let at = *slot as usize - start;
-                        (entries[at], cells[at]) = (*n, c);
+                        entries[*slot as usize - start] = Entry { neighbour, cell };
                         *slot += 1;
                     }
                 }
                 // Then by cell within each block, stably (nothing moves across a block's edge).
-                sort_by_cell(entries, cells);
+                sort_by_cell(entries);
             }
         }));
     }
@@ -242,12 +256,12 @@ impl NeighbourGrid {
             );
             // The blocks' entries in cells x0..=x1 of this row (they are in the order of their cells).
             let (first, last) = (y * self.cols + x0, y * self.cols + x1);
-            for (n, &c) in self.entries[a..b].iter().zip(&self.entry_cell[a..b]) {
-                if c > last {
+            for e in &self.entries[a..b] {
+                if e.cell > last {
                     break;
                 }
-                if c >= first && n.position.distance_squared(p) <= r2 {
-                    f(n);
+                if e.cell >= first && e.neighbour.position.distance_squared(p) <= r2 {
+                    f(&e.neighbour);
                 }
             }
         }
@@ -292,23 +306,20 @@ impl NeighbourGrid {
     }
 }
 
-/// Sorts `entries` by their `cells`, stably: by insertion, since an entry out of order is rare
+/// Sorts `entries` by their cells, stably: by insertion, since an entry out of order is rare
 /// and near its place (a block holds a creature or two).
-fn sort_by_cell(entries: &mut [Neighbour], cells: &mut [u32]) {
-    for i in 1..cells.len() {
-        let c = cells[i];
-        if cells[i - 1] <= c {
+fn sort_by_cell(entries: &mut [Entry]) {
+    for i in 1..entries.len() {
+        let e = entries[i];
+        if entries[i - 1].cell <= e.cell {
             continue;
         }
-        let n = entries[i];
         let mut j = i;
-        while j > 0 && cells[j - 1] > c {
+        while j > 0 && entries[j - 1].cell > e.cell {
             entries[j] = entries[j - 1];
-            cells[j] = cells[j - 1];
             j -= 1;
         }
-        entries[j] = n;
-        cells[j] = c;
+        entries[j] = e;
     }
 }
 
