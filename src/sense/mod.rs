@@ -44,7 +44,7 @@ pub struct Neighbour {
 }
 
 /// A creature in the index, and its cell (`row * cols + column`) beside it: a query reads
-/// both from one line of the cache (32 bytes), where two arrays missed it twice in a crowd.
+/// both from one line of the cache (32 bytes), the fill and the sort by cell move one thing.
 #[derive(Clone, Copy, Debug)]
 struct Entry {
     neighbour: Neighbour,
@@ -195,7 +195,7 @@ impl NeighbourGrid {
             *start = sum;
         }
         // Range r fills the entries from where its first block starts, its cursors
-        // `block_start[edge[r] + 1..edge[r + 1] + 1]`. Every slot is written, so the arrays are
+        // `block_start[edge[r] + 1..edge[r + 1] + 1]`. Every slot is written, so the array is
         // only resized (not cleared and filled first: a pass of its own).
         self.entries.resize(
             len,
