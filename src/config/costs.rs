@@ -32,7 +32,8 @@ pub struct CostModel {
     pub contact_search_us: f32,
     /// What the point-mass and hybrid levels and the choice cost per creature in a crowd, where
     /// they run across the cores, as shares of the figures above (measured on one thread, the
-    /// choice at 2,000 creatures): at the smallest crowd measured. A file without it predicts a crowd at those figures.
+    /// choice at 2,000 creatures): at the smallest crowd measured. A file without it predicts a
+    /// crowd at those figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_shares: Option<CrowdShares>,
     /// The same shares measured at larger crowds, smallest first: a crowd's share is

@@ -223,6 +223,13 @@ impl Step {
         let descending = 0x7FFF_FFFF - (self.ratio.to_bits() & 0x7FFF_FFFF);
         (u64::from(descending) << serial_bits) | u64::from(self.serial)
     }
+
+    /// Sorts `steps` into the order they are taken, by their key: one radix sort, stable (so
+    /// each creature's steps stay in the order of its hull). `most_serial` is the largest serial.
+    fn sort(steps: &mut [Step], most_serial: u32) {
+        let serial_bits = u32::BITS - most_serial.leading_zeros();
+        radsort::sort_by_key(steps, |s| s.order_key(serial_bits));
+    }
 }
 
 impl PartialOrd for Step {
@@ -296,8 +303,7 @@ pub fn allocate<S: Send>(
     // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
     if spent + cheapest_us <= budget_us {
-        let serial_bits = u32::BITS - most_serial.leading_zeros();
-        radsort::sort_by_key(&mut listed, |s| s.order_key(serial_bits));
+        Step::sort(&mut listed, most_serial);
     } else {
         listed.clear();
     }
@@ -1234,6 +1240,15 @@ mod tests {
         switch_to_rigid_us: 50.0,
     };
 
+    /// Numbers in [0, 1) from `seed`, the same every run (a linear congruential generator).
+    fn uniform(seed: u64) -> impl FnMut() -> f32 {
+        let mut seed = seed;
+        move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     fn candidate(serial: u32, current: Lod, rigid_benefit: f32) -> Candidate<'static> {
         Candidate {
             serial,
@@ -1287,11 +1302,7 @@ mod tests {
     /// A crowd of `n` with mixed levels and dwells, and each one's exact rigid benefit; half of
     /// them are in view (a hybrid benefit), a few dearer (another kind).
     fn mixed_crowd(n: u32) -> (Vec<Candidate<'static>>, Vec<f32>) {
-        let mut seed = 99u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(99);
         let mut exact = Vec::new();
         let crowd = (0..n)
             .map(|i| {
@@ -1513,11 +1524,7 @@ mod tests {
         let b = &rules.budget;
         let half = Vec2::splat(60.0);
         // A crowd at the game's density and some strays far apart, moving up to 3 m/s.
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(12345);
         let creatures: Vec<(Creature, PlanarState)> = (0..3000)
             .map(|i| {
                 let spread = if i < 2800 { 0.4 } else { 1.0 };
@@ -1593,11 +1600,7 @@ mod tests {
             NeighbourGrid::new(half, 1.6),
         );
         let scene = test_scene(b, &puck, &court, &grid, &camera, 30.0);
-        let mut seed = 7u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(7);
         let (mut spared, mut weighed) = (0, 0);
         for _ in 0..20_000 {
             let s = PlanarState {
@@ -1628,11 +1631,7 @@ mod tests {
 
     #[test]
     fn steps_sorted_by_their_key_are_in_the_order_they_are_taken() {
-        let mut seed = 3u64;
-        let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            (seed >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = uniform(3);
         let ratios = [0.0, 1e-30, 0.006, 0.5, 7.0, f32::INFINITY];
         for most_serial in [5u32, 1000, 100_000, u32::MAX] {
             let mut steps: Vec<Step> = (0..4000)
@@ -1655,8 +1654,7 @@ mod tests {
                     }
                 })
                 .collect();
-            let serial_bits = u32::BITS - most_serial.leading_zeros();
-            radsort::sort_by_key(&mut steps, |s| s.order_key(serial_bits));
+            Step::sort(&mut steps, most_serial);
             assert!(steps.windows(2).all(|w| w[0] >= w[1]), "up to serial {most_serial}");
         }
     }
