@@ -75,8 +75,8 @@ fn switch_levels(
         &mut LevelChoice,
         &GaitPhase,
         &CollisionRecord,
-        (&PlanarState, &GaitPose, Option<&SwitchBlend>, &mut DrawnBefore),
-        &FrameStep,
+        (&PlanarState, &mut GaitPose, Option<&SwitchBlend>, &mut DrawnBefore),
+        &mut FrameStep,
     )>,
 ) {
     let now = clock.seconds() as f32;
@@ -98,8 +98,8 @@ fn switch_levels(
     attend.clear();
     for (entity, _, lod, choice, _, record, _, frame) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
         let mut i = 0;
-        while let Some(skip) = frame[i..].iter().position(|f| !f.behind) {
-            i += skip;
+        while let Some(next) = FrameStep::next_not_behind(frame, i) {
+            i = next;
             if attends(lod[i], &choice[i], &record[i]) {
                 attend.push(entity[i]);
             }
@@ -114,12 +114,16 @@ fn switch_levels(
         }
     }
     for &entity in attend.iter() {
-        let Ok((entity, creature, &lod, mut choice, gait, record, (state, pose, blend, mut before), _)) =
+        let Ok((entity, creature, &lod, mut choice, gait, record, (state, mut pose, blend, mut before), mut frame)) =
             creatures.get_mut(entity)
         else {
             continue;
         };
         let kind = &kinds[creature.kind];
+        // Left unposed at its frame's catch-up, if nothing read it then.
+        if frame.pose_stale {
+            frame.pose_now(kind, lod, state, gait, &mut pose);
+        }
         // Under a fixed policy ("every creature at the point-mass level") a collision does not
         // overrule it; under the budget policy only a rigid level the budget paid for skips
         // the window.
@@ -136,7 +140,7 @@ fn switch_levels(
             continue;
         }
         // What is drawn now (as the last tick left it), blended and by the model alone.
-        let model = Drawn::of(state, pose);
+        let model = Drawn::of(state, &pose);
         let seen = (blend.map_or(model, |b| b.apply(&model, now)), model);
         let progress = gait.flight_progress();
         let unseen = lod == Lod::PointMass && !camera.shows(kind, state);

@@ -167,10 +167,52 @@ fn enter_point_mass(
 /// start while the frame's ticks go by, and is moved on to the frame's last tick in one step at
 /// that tick, or as soon as something needs it sooner: the same closed form from the same start
 /// as a tick at a time, so the same state bit for bit, for one pass over a crowd a frame.
+///
+/// A hybrid caught up this way is not posed: its pose is worked out from its gait and speed
+/// (a function of the two alone) when something may next read it, at a switch or when it is
+/// next stepped; until then [`GaitPose`] holds an older pose and `pose_stale` says so.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStep {
     /// Holds the state of its frame's start: the frame's ticks are still to step.
     pub behind: bool,
+    /// Its pose was left at its last catch-up: see [`FrameStep::pose_now`].
+    pub pose_stale: bool,
+}
+
+impl FrameStep {
+    /// The first of `frames` from `from` on that is not behind its frame. In a crowd nearly all
+    /// are: the flags are tested a run at a time, in one vector pass that does not stop early,
+    /// and only a run that has one is searched.
+    pub fn next_not_behind(frames: &[FrameStep], from: usize) -> Option<usize> {
+        const RUN: usize = 64;
+        let mut start = from;
+        while start < frames.len() {
+            let run = &frames[start..(start + RUN).min(frames.len())];
+            if !run.iter().fold(true, |all, f| all & f.behind) {
+                return run.iter().position(|f| !f.behind).map(|i| start + i);
+            }
+            start += run.len();
+        }
+        None
+    }
+
+    /// Works out a pose left stale by a catch-up, for a reader that needs it now: the same
+    /// pose, bit for bit, as stepping the creature there would have published.
+    pub fn pose_now(
+        &mut self,
+        kind: &KindParams,
+        lod: Lod,
+        state: &PlanarState,
+        gait: &GaitPhase,
+        pose: &mut GaitPose,
+    ) {
+        if std::mem::take(&mut self.pose_stale)
+            && lod == Lod::Hybrid
+            && let Some(table) = &kind.gait
+        {
+            *pose = hybrid::pose(gait, &table.at(state.velocity.length()), table.steps_per_stride);
+        }
+    }
 }
 
 /// Whether planar creatures may fall behind their frame ([`FrameStep`]); absent, they may.
@@ -253,8 +295,17 @@ impl<'a> PlanarStepper<'a> {
 
     /// Moves one creature from the state and gait it holds, `ticks` ticks before the end of
     /// this tick, to the end of this tick at its desired velocity: the plane, the gait's
-    /// rhythm, and (for a hybrid) the pose, which depends on the speed and the gait's place alone.
-    pub fn advance(&self, creature: &Creature, lod: Lod, desired: Vec2, (state, gait, pose): Moving, ticks: u64) {
+    /// rhythm, and (for a hybrid, if `posed`) the pose, which depends on the speed and the
+    /// gait's place alone.
+    fn advance(
+        &self,
+        creature: &Creature,
+        lod: Lod,
+        desired: Vec2,
+        (state, gait, pose): Moving,
+        ticks: u64,
+        posed: bool,
+    ) {
         let kind = &self.kinds[creature.kind];
         let table = match (lod, &kind.gait) {
             (Lod::Hybrid, Some(table)) => Some(table),
@@ -272,23 +323,25 @@ impl<'a> PlanarStepper<'a> {
             Some(table) => {
                 let at = table.at(state.velocity.length());
                 *gait = Rhythm::of_table(table, &at).advance(gait, seconds, self.end_s);
-                *pose = hybrid::pose(gait, &at, table.steps_per_stride);
+                if posed {
+                    *pose = hybrid::pose(gait, &at, table.steps_per_stride);
+                }
             }
             None => *gait = point_mass.advance(gait, seconds, self.end_s),
         }
     }
 
-    /// Moves a creature on its stretch to the end of this tick. A new stretch begins from where
-    /// the creature is: with its first tick `first_tick` where given (a decision's tick; a
-    /// creature behind its frame, held at the frame's start), else with this tick if anything but
-    /// the stepper has moved it since the last.
+    /// Moves a creature on its stretch to the end of this tick, posed: it is up to date. A new
+    /// stretch begins from where the creature is: with its first tick `first_tick` where given
+    /// (a decision's tick; a creature behind its frame, held at the frame's start), else with
+    /// this tick if anything but the stepper has moved it since the last.
     pub fn follow(
         &self,
         creature: &Creature,
         lod: Lod,
         desired: Vec2,
         (state, gait, pose): Moving,
-        segment: &mut PlanarSegment,
+        (frame, segment): (&mut FrameStep, &mut PlanarSegment),
         first_tick: Option<u64>,
     ) {
         match first_tick {
@@ -300,8 +353,9 @@ impl<'a> PlanarStepper<'a> {
         }
         (*state, *gait) = (segment.start, segment.start_gait);
         let ticks = self.clock.tick + 1 - segment.first_tick;
-        self.advance(creature, lod, desired, (state, gait, pose), ticks);
+        self.advance(creature, lod, desired, (state, gait, pose), ticks, true);
         (segment.published, segment.published_gait) = (*state, *gait);
+        *frame = FrameStep::default();
     }
 }
 
@@ -332,12 +386,16 @@ pub(crate) fn step_point_masses(
                 segment: &mut PlanarSegment| {
         if frame.behind {
             if last_of_frame {
-                frame.behind = false;
-                stepper.advance(creature, lod, desired, moving, in_frame + 1);
+                // Nothing reads it before the next decision: its pose waits for a reader.
+                *frame = FrameStep {
+                    behind: false,
+                    pose_stale: true,
+                };
+                stepper.advance(creature, lod, desired, moving, in_frame + 1, false);
             }
         } else {
             let first_tick = (in_frame == 0).then_some(clock.tick);
-            stepper.follow(creature, lod, desired, moving, segment, first_tick);
+            stepper.follow(creature, lod, desired, moving, (frame, segment), first_tick);
         }
     };
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
@@ -359,8 +417,8 @@ pub(crate) fn step_point_masses(
                     // Only the creatures not behind move: found by a scan of their flags alone,
                     // not a walk over every column (in a crowd nearly all are behind).
                     let mut i = 0;
-                    while let Some(skip) = f[i..].iter().position(|f| !f.behind) {
-                        i += skip;
+                    while let Some(next) = FrameStep::next_not_behind(f, i) {
+                        i = next;
                         step(
                             &c[i],
                             l[i],
@@ -519,6 +577,24 @@ pub(crate) mod tests {
         k.turn_rate_rad_per_s = 1.0;
         let s = planar_after(&start, Vec2::new(0.0, 1.0), &k, &TurnLimit::new(&k, 0.5), 50, 0.01);
         assert!((s.heading_angle() - 0.5).abs() < 1e-6, "{}", s.heading_angle());
+    }
+
+    #[test]
+    fn the_scan_for_creatures_not_behind_finds_each_in_order_across_its_runs() {
+        let not_behind = [0, 5, 63, 64, 65, 130, 199];
+        let frames: Vec<FrameStep> = (0..200)
+            .map(|i| FrameStep {
+                behind: !not_behind.contains(&i),
+                pose_stale: i % 3 == 0,
+            })
+            .collect();
+        let found: Vec<usize> = std::iter::successors(FrameStep::next_not_behind(&frames, 0), |&i| {
+            FrameStep::next_not_behind(&frames, i + 1)
+        })
+        .collect();
+        assert_eq!(found, not_behind);
+        assert_eq!(FrameStep::next_not_behind(&frames[66..130], 0), None);
+        assert_eq!(FrameStep::next_not_behind(&[], 0), None);
     }
 
     #[test]

@@ -253,7 +253,7 @@ fn plan_frames(
     {
         let frame = frame.bypass_change_detection();
         if probed || player {
-            frame.fill(FrameStep { behind: false });
+            frame.iter_mut().for_each(|f| f.behind = false);
             continue;
         }
         let n = chunk_len(config.scenario.creature_count(), creature.len());
@@ -358,8 +358,14 @@ fn detect_collisions(
             }
             // Moved from the frame's start: its stretch begins at the decision's tick.
             let first_tick = Some(clock.tick - in_frame);
-            stepper.follow(creature, *lod, desired.0, (state, gait, pose), segment, first_tick);
-            frame.behind = false;
+            stepper.follow(
+                creature,
+                *lod,
+                desired.0,
+                (state, gait, pose),
+                (frame, segment),
+                first_tick,
+            );
         }
         let kind = &kinds[creature.kind];
         // Steering saw no creature near enough to touch now (but a player's creature does not steer).
