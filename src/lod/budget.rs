@@ -224,11 +224,39 @@ impl Step {
         (u64::from(descending) << serial_bits) | u64::from(self.serial)
     }
 
-    /// Sorts `steps` into the order they are taken, by their key: one radix sort, stable (so
-    /// each creature's steps stay in the order of its hull). `most_serial` is the largest serial.
-    fn sort(steps: &mut [Step], most_serial: u32) {
+    /// Sorts `steps` into the order they are taken, by their key: radix sorts, stable (so each
+    /// creature's steps stay in the order of its hull). `most_serial` is the largest serial.
+    fn sort(steps: &mut Vec<Step>, most_serial: u32) {
         let serial_bits = u32::BITS - most_serial.leading_zeros();
-        radsort::sort_by_key(steps, |s| s.order_key(serial_bits));
+        let key = |s: &Step| s.order_key(serial_bits);
+        if steps.len() < 2 * SORT_HALF_STEPS {
+            radsort::sort_by_key(steps, key);
+            return;
+        }
+        // Two halves sorted across the cores, then merged, the first half's first among equal
+        // keys: the order one stable sort gives.
+        let mid = steps.len() / 2;
+        let (first, second) = steps.split_at_mut(mid);
+        run_chunks(
+            [first, second]
+                .into_iter()
+                .map(|half| move || radsort::sort_by_key(half, key)),
+        );
+        let (first, second) = steps.split_at(mid);
+        let mut merged = Vec::with_capacity(steps.len());
+        let (mut i, mut j) = (0, 0);
+        while i < first.len() && j < second.len() {
+            if key(&second[j]) < key(&first[i]) {
+                merged.push(second[j]);
+                j += 1;
+            } else {
+                merged.push(first[i]);
+                i += 1;
+            }
+        }
+        merged.extend_from_slice(&first[i..]);
+        merged.extend_from_slice(&second[j..]);
+        *steps = merged;
     }
 }
 
@@ -526,6 +554,10 @@ impl<S: Send> SettledAhead<S> {
 
 /// The most bounds settled ahead at once.
 const MAX_SETTLED_AHEAD: usize = 4096;
+
+/// Below twice this many steps, the knapsack's list is sorted in one piece: a half of it would
+/// not pay for a core's start.
+const SORT_HALF_STEPS: usize = 16_384;
 
 /// Every creature at its floor, gathered one by one before any benefit is worked out: what
 /// the floors cost, and whether any creature's cheapest step up fits beside them (if not,
@@ -1633,9 +1665,11 @@ mod tests {
     fn steps_sorted_by_their_key_are_in_the_order_they_are_taken() {
         let mut next = uniform(3);
         let ratios = [0.0, 1e-30, 0.006, 0.5, 7.0, f32::INFINITY];
-        for most_serial in [5u32, 1000, 100_000, u32::MAX] {
-            let mut steps: Vec<Step> = (0..4000)
-                .map(|_| {
+        bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
+        // In one piece, and in halves across the cores.
+        for (most_serial, count) in [(5u32, 4000), (1000, 4000), (100_000, 40_000), (u32::MAX, 40_001)] {
+            let mut steps: Vec<Step> = (0..count)
+                .map(|i| {
                     // Many equal ratios, as a crowd's unsearched bounds have.
                     let ratio = if next() < 0.5 {
                         ratios[(next() * 6.0) as usize]
@@ -1646,7 +1680,8 @@ mod tests {
                         ratio,
                         bound: false,
                         serial: (next() * most_serial as f32) as u32,
-                        creature: 0,
+                        // Where it was listed: among equal steps, that order is kept.
+                        creature: i,
                         from: Lod::PointMass,
                         to: Lod::Rigid,
                         extra_us: 1.0,
@@ -1655,7 +1690,12 @@ mod tests {
                 })
                 .collect();
             Step::sort(&mut steps, most_serial);
-            assert!(steps.windows(2).all(|w| w[0] >= w[1]), "up to serial {most_serial}");
+            assert!(
+                steps
+                    .windows(2)
+                    .all(|w| w[0] > w[1] || (w[0] == w[1] && w[0].creature < w[1].creature)),
+                "up to serial {most_serial}"
+            );
         }
     }
 
