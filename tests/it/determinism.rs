@@ -110,6 +110,52 @@ fn creatures_stepped_a_frame_at_a_time_end_where_they_would_a_tick_at_a_time() {
     }
 }
 
+/// Every creature's pose after `seconds` (a frame's end) with frame stepping on or off, each
+/// stale one worked out on demand, by serial; and how many were stale and how many of those
+/// held a pose other than their own.
+fn poses_at_frame_end(
+    config: &simlod::config::SimConfig,
+    enabled: bool,
+    seconds: f64,
+) -> (Vec<(u32, simlod::gait::GaitPose)>, usize, usize) {
+    use simlod::creature::{Creature, GaitPhase, KindTable};
+    use simlod::gait::GaitPose;
+    let mut sim = simlod::headless::HeadlessSim::new(config.clone());
+    sim.app.insert_resource(FrameStepping { enabled });
+    sim.run_for(seconds);
+    let (mut stale, mut moved) = (0, 0);
+    let mut poses = sim.app.world_mut().resource_scope(|world, kinds: Mut<KindTable>| {
+        world
+            .query::<(&Creature, &Lod, &PlanarState, &GaitPhase, &mut GaitPose, &mut FrameStep)>()
+            .iter_mut(world)
+            .map(|(c, &lod, state, gait, mut pose, mut frame)| {
+                let held = *pose;
+                if frame.pose_stale {
+                    stale += 1;
+                    frame.pose_now(&kinds[c.kind], lod, state, gait, &mut pose);
+                    moved += usize::from(*pose != held);
+                }
+                (c.serial, *pose)
+            })
+            .collect::<Vec<_>>()
+    });
+    poses.sort_by_key(|p| p.0);
+    (poses, stale, moved)
+}
+
+#[test]
+fn a_hybrid_left_unposed_behind_its_frame_is_posed_on_demand_as_a_tick_at_a_time_poses_it() {
+    let config = scene(&[("hopper", 90), ("biped", 30)], simlod::lod::LevelPolicy::AllHybrid);
+    let (on, stale, moved) = poses_at_frame_end(&config, true, 4.0);
+    let (off, none, _) = poses_at_frame_end(&config, false, 4.0);
+    assert_eq!(none, 0, "stepped a tick at a time, every pose is worked out");
+    assert!(
+        stale > 30 && moved > 30,
+        "{stale} of 120 left unposed, {moved} of them out of date"
+    );
+    assert_eq!(on, off);
+}
+
 #[test]
 fn creatures_behind_their_frame_are_caught_up_when_the_puck_goes_farther_than_it_could() {
     let config = scene(&[("hopper", 200)], simlod::lod::LevelPolicy::AllPointMass);
