@@ -328,7 +328,7 @@ pub fn allocate<S: Send>(
         cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us(&p));
         c.list_hull(i as u32, &hull, &p, &mut listed);
     }
-    // Best first (one radix sort); after a search, the searched creature's steps (few) wait in
+    // Best first (`Step::sort`); after a search, the searched creature's steps (few) wait in
     // a heap beside them.
     if spent + cheapest_us <= budget_us {
         Step::sort(&mut listed, most_serial);

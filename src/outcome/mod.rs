@@ -370,9 +370,7 @@ fn detect_collisions(
         let kind = &kinds[creature.kind];
         // A contact may move it: a pose its catch-up left is that of where it was stepped to
         // (only when every creature is checked, after a respawn or a shove of the puck).
-        if frame.pose_stale {
-            frame.pose_now(kind, *lod, state, gait, pose);
-        }
+        frame.pose_now(kind, *lod, state, gait, pose);
         // Steering saw no creature near enough to touch now (but a player's creature does not steer).
         let clear = !player && clear_of_creatures(clearance, kind, widest_m, state.velocity.length(), clock.dt);
         collide(entity, creature, state, record, (decision && !clear).then_some(&*grid));
