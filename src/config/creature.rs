@@ -304,6 +304,15 @@ pub struct SteeringConfig {
     pub separation_distance_m: f32,
     /// Weight of keeping apart from other creatures.
     pub separation_weight: f32,
+    /// Steering's level of detail: a creature with nothing within these reaches (the puck's
+    /// path, the walls, another creature) looks around once in this many decisions and keeps
+    /// its desired velocity between; 1 to 64 (1: every decision, as steering did before).
+    #[serde(default = "every_decision")]
+    pub look_every_decisions_when_clear: u32,
+}
+
+fn every_decision() -> u32 {
+    1
 }
 
 impl Validate for CreatureDef {
@@ -373,6 +382,11 @@ impl Validate for CreatureDef {
             v.range("wall_weight", s.wall_weight, 0.0, 1000.0);
             v.range("separation_distance_m", s.separation_distance_m, 0.0, 100.0);
             v.range("separation_weight", s.separation_weight, 0.0, 1000.0);
+            v.require(
+                (1..=64).contains(&s.look_every_decisions_when_clear),
+                "look_every_decisions_when_clear",
+                format!("must be 1 to 64, not {}", s.look_every_decisions_when_clear),
+            );
             v.require(
                 s.cruise_speed_m_per_s.is_nan() || s.cruise_speed_m_per_s <= self.top_speed_m_per_s,
                 "cruise_speed_m_per_s",

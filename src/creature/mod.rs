@@ -16,15 +16,20 @@ use crate::contract::Lod;
 use crate::contract::{SimStart, StartStage, WorldRng};
 use std::collections::HashMap;
 
-/// Hands out creature serials.
+/// Hands out creature serials, and keeps where creatures were respawned since the last steering
+/// decision: steering wakes a creature that looks around rarely when one lands near it.
 #[derive(Resource, Debug, Default)]
-pub struct SerialCounter(pub u32);
+pub struct Newcomers {
+    next_serial: u32,
+    /// Where creatures were respawned since the last decision.
+    pub respawned_at: Vec<Vec2>,
+}
 
-impl SerialCounter {
+impl Newcomers {
     /// The next serial.
     pub fn take(&mut self) -> u32 {
-        self.0 += 1;
-        self.0 - 1
+        self.next_serial += 1;
+        self.next_serial - 1
     }
 }
 
@@ -117,7 +122,7 @@ impl Occupancy {
 /// Places the scenario's creatures in free parts of the court, numbered from 0.
 pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mut rng: ResMut<WorldRng>) {
     let kinds = KindTable::of(&config);
-    let mut serials = SerialCounter::default();
+    let mut newcomers = Newcomers::default();
     let half = config.arena.half_extents();
     let clear = config.arena.respawn_creature_clearance_m;
     let biggest = config.kinds.iter().map(|k| k.body.radius_m).fold(0.0, f32::max);
@@ -143,7 +148,7 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
             batch.push(creature_bundle(
                 kind,
                 &kinds[kind],
-                serials.take(),
+                newcomers.take(),
                 level,
                 spot,
                 0.0,
@@ -163,7 +168,7 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
     });
     // The kinds first: a creature's level builds its model from them as it is spawned.
     commands.insert_resource(kinds);
-    commands.insert_resource(serials);
+    commands.insert_resource(newcomers);
     commands.spawn_batch(batch);
 }
 

@@ -8,9 +8,9 @@
 
 use bevy::prelude::*;
 
-use super::{Creature, DesiredVelocity, KindParams, KindTable, PlanarState, PlayerControlled};
+use super::{Creature, DesiredVelocity, KindParams, KindTable, Newcomers, PlanarState, PlayerControlled};
 use crate::config::SimConfig;
-use crate::contract::{DENSE, SimClock, SimStage, chunk_len, run_chunks};
+use crate::contract::{DENSE, Lod, SimClock, SimStage, chunk_len, run_chunks};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
 
@@ -51,18 +51,40 @@ pub struct Surroundings<'a> {
     pub decision_dt: f32,
 }
 
-/// How far from a creature, at its last decision, no other creature's centre was: what steering
-/// saw of its neighbours as it kept apart from them, looking as far as its separation distance
-/// (0 where it did not look). The contact check between creatures need not search again
-/// where this is wider than any contact the creature could make before it is checked.
+/// Slack on each reach for the rounding of positions summed over a frame's ticks (an f32
+/// position 1,500 m from the centre rounds by about 0.1 mm a tick).
+pub const REACH_SLACK_M: f32 = 0.01;
+
+/// How far from a creature no other creature's centre can be: what steering saw of its
+/// neighbours as it kept apart from them, looking as far as its separation distance (0 where it
+/// did not look), less how far it and any other creature could have closed in since. The
+/// contact check between creatures need not search again where this is wider than any contact
+/// the creature could make before it is checked.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct Clearance {
-    /// Metres between the creature's centre and the nearest other centre, or how far it looked.
+    /// Metres: at most the distance between the creature's centre and the nearest other centre.
     pub clear_m: f32,
+    /// The decision at which steering looks around the creature again (steering's level of
+    /// detail: a creature with nothing within reach looks around once in
+    /// `look_every_decisions_when_clear`). Until then it keeps its desired velocity. Counted
+    /// modulo 2^32 (four years at 30 decisions a second): a wrong wait after the count wraps
+    /// round is bounded by `clear_m` all the same.
+    pub look_again: u32,
+}
+
+impl Clearance {
+    /// Whether no other creature is near enough to touch this one at the decision's contact
+    /// check: `clear_m` is wider than any footprint's reach and a tick of its motion at
+    /// `speed_m_per_s` (the index holds where the creatures were before it).
+    pub fn clear_of_creatures(&self, kind: &KindParams, widest_m: f32, speed_m_per_s: f32, dt: f32) -> bool {
+        self.clear_m > kind.radius_m + widest_m + speed_m_per_s * dt + REACH_SLACK_M
+    }
 }
 
 /// The velocity a creature wants, given where it is and what is around it; and its
-/// [`Clearance`] there.
+/// [`Clearance`] there, with the decision it looks around again: the next of its turns (one
+/// decision in `look_every_decisions_when_clear`, staggered by serial) if nothing is within
+/// reach until then, at the speeds of now, else the next decision.
 pub fn desired_velocity(
     creature: &Creature,
     state: &PlanarState,
@@ -72,6 +94,11 @@ pub fn desired_velocity(
     let s = &kind.steering;
     let p = state.position;
     let top = kind.top_speed_m_per_s;
+    // How far it could go before its next turn to look around.
+    let every = s.look_every_decisions_when_clear;
+    let wait_s = (every - 1) as f32 * around.decision_dt;
+    let own_reach_m = state.velocity.length().max(top) * wait_s;
+    let mut clear_until_turn = true;
 
     // Wander: keep going the way it faces, drifting a little.
     let turn =
@@ -84,6 +111,7 @@ pub fn desired_velocity(
     let path_end = puck.position + puck.velocity * s.puck_lookahead_s;
     let from_path = p - nearest_on_segment(p, puck.position, path_end);
     let gap = from_path.length() - puck.radius_m - kind.radius_m;
+    clear_until_turn &= gap >= s.puck_alert_distance_m + own_reach_m + puck.velocity.length() * wait_s;
     if s.puck_alert_distance_m > 0.0 && gap < s.puck_alert_distance_m {
         let urgency = (1.0 - gap / s.puck_alert_distance_m).clamp(0.0, 1.0);
         let away = from_path
@@ -108,6 +136,7 @@ pub fn desired_velocity(
         });
         desired += push * (top * s.separation_weight);
     }
+    clear_until_turn &= clear_m >= s.separation_distance_m;
 
     // Keep off the walls: a push inward, and no motion outward right at the wall.
     if s.wall_avoid_distance_m > 0.0 {
@@ -115,6 +144,7 @@ pub fn desired_velocity(
         for axis in 0..2 {
             for sign in [-1.0f32, 1.0] {
                 let gap = half[axis] - sign * p[axis];
+                clear_until_turn &= gap >= s.wall_avoid_distance_m + own_reach_m;
                 if gap < s.wall_avoid_distance_m {
                     let closeness = (1.0 - gap / s.wall_avoid_distance_m).clamp(0.0, 1.0);
                     desired[axis] -= sign * top * s.wall_weight * closeness * closeness;
@@ -127,9 +157,33 @@ pub fn desired_velocity(
         }
     }
 
-    (desired.clamp_length_max(top), Clearance { clear_m })
+    let decision = around.decision as u32;
+    let look_again = if clear_until_turn && every > 1 {
+        decision.wrapping_add(every - decision.wrapping_add(creature.serial) % every)
+    } else {
+        decision.wrapping_add(1)
+    };
+    (desired.clamp_length_max(top), Clearance { clear_m, look_again })
 }
 
+/// More respawns than this in a frame wake every creature: each would otherwise test them all.
+const MOST_RESPAWNS_TESTED: usize = 16;
+
+/// The puck's heading moving by more than this (the square of the chord between unit headings)
+/// since every creature last looked around wakes them all: a bounce swings its predicted path
+/// farther than any creature could go.
+const PUCK_TURN_WAKES: f32 = 3.0e-4; // about one degree
+
+/// What steering remembers from one decision to the next.
+#[derive(Default)]
+struct LookAround {
+    /// The puck's heading when every creature last looked around.
+    puck_heading: Vec2,
+    /// The fastest creature at the last decision, m/s.
+    fastest_m_per_s: f32,
+}
+
+#[allow(clippy::too_many_arguments)]
 fn steer(
     clock: Res<SimClock>,
     config: Res<SimConfig>,
@@ -137,7 +191,12 @@ fn steer(
     puck: Res<PuckState>,
     court: Res<Court>,
     grid: Res<NeighbourGrid>,
-    mut creatures: Query<(&Creature, &PlanarState, &mut DesiredVelocity, &mut Clearance), Without<PlayerControlled>>,
+    mut newcomers: ResMut<Newcomers>,
+    mut memory: Local<LookAround>,
+    mut creatures: Query<
+        (&Creature, &PlanarState, &Lod, &mut DesiredVelocity, &mut Clearance),
+        Without<PlayerControlled>,
+    >,
 ) {
     if !clock.is_decision_tick() {
         return;
@@ -150,17 +209,49 @@ fn steer(
         decision: clock.decision(),
         decision_dt: clock.dt * clock.ticks_per_decision as f32,
     };
-    let steer_one = |creature: &Creature, state: &PlanarState, desired: &mut DesiredVelocity, clear: &mut Clearance| {
-        (desired.0, *clear) = desired_velocity(creature, state, &kinds[creature.kind], &around);
-    };
-    for (creature, state, mut desired, mut clear) in creatures.contiguous_iter_mut().expect(DENSE) {
+    // How far any two creatures could have closed in since the last decision: each moves below
+    // the larger of its speed at a frame's start and its top speed.
+    let (fastest, widest_m) = grid.fastest_and_widest();
+    let speed_bound = (kinds.0.iter().map(|k| k.top_speed_m_per_s)).fold(fastest.max(memory.fastest_m_per_s), f32::max);
+    let closed_m = 2.0 * speed_bound * around.decision_dt + REACH_SLACK_M;
+    memory.fastest_m_per_s = fastest;
+    let heading = puck.velocity.normalize_or_zero();
+    let wake_all = heading.distance_squared(memory.puck_heading) > PUCK_TURN_WAKES
+        || newcomers.respawned_at.len() > MOST_RESPAWNS_TESTED;
+    if wake_all {
+        memory.puck_heading = heading;
+    }
+    let respawned_at = std::mem::take(&mut newcomers.respawned_at);
+    let decision = around.decision as u32;
+    let steer_one =
+        |creature: &Creature, state: &PlanarState, lod: Lod, desired: &mut DesiredVelocity, clear: &mut Clearance| {
+            let kind = &kinds[creature.kind];
+            // A rigid creature looks at every decision: beside its dynamics steering costs nothing.
+            if lod != Lod::Rigid && decision < clear.look_again && !wake_all {
+                // Not its turn: nothing was within reach, and its clearance still keeps it clear.
+                let kept = Clearance {
+                    clear_m: clear.clear_m - closed_m,
+                    ..*clear
+                };
+                let woken = respawned_at
+                    .iter()
+                    .any(|a| a.distance(state.position) < clear.clear_m + closed_m);
+                if !woken && kept.clear_of_creatures(kind, widest_m, speed_bound, clock.dt) {
+                    *clear = kept;
+                    return;
+                }
+            }
+            (desired.0, *clear) = desired_velocity(creature, state, kind, &around);
+        };
+    for (creature, state, lod, mut desired, mut clear) in creatures.contiguous_iter_mut().expect(DENSE) {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         let (desired, clear) = (desired.bypass_change_detection(), clear.bypass_change_detection());
-        let chunks = (creature.chunks(n).zip(state.chunks(n))).zip(desired.chunks_mut(n).zip(clear.chunks_mut(n)));
-        run_chunks(chunks.map(|((c, s), (d, cl))| {
+        let chunks = (creature.chunks(n).zip(state.chunks(n)).zip(lod.chunks(n)))
+            .zip(desired.chunks_mut(n).zip(clear.chunks_mut(n)));
+        run_chunks(chunks.map(|(((c, s), l), (d, cl))| {
             move || {
-                for ((c, s), (d, cl)) in c.iter().zip(s).zip(d.iter_mut().zip(cl)) {
-                    steer_one(c, s, d, cl);
+                for (((c, s), l), (d, cl)) in c.iter().zip(s).zip(l).zip(d.iter_mut().zip(cl)) {
+                    steer_one(c, s, *l, d, cl);
                 }
             }
         }));

@@ -484,6 +484,7 @@ pub(crate) mod tests {
                 wall_weight: 0.0,
                 separation_distance_m: 0.0,
                 separation_weight: 0.0,
+                look_every_decisions_when_clear: 1,
             },
             rigid: None,
             gait: None,

@@ -23,7 +23,8 @@ use crate::contract::GaitPose;
 use crate::contract::{AtRigid, Lod};
 use crate::contract::{DENSE, SimClock, SimStage, SimStart, WorldRng, chunk_len, run_chunks};
 use crate::contract::{DesiredVelocity, GaitPhase, PlanarState, PlayerControlled};
-use crate::creature::{Clearance, SerialCounter, creature_bundle, find_free_spot};
+use crate::creature::steering::REACH_SLACK_M;
+use crate::creature::{Clearance, Newcomers, creature_bundle, find_free_spot};
 use crate::kind::{Creature, KindParams, KindTable};
 use crate::lod::{
     BudgetSummary, BudgetTally, LevelChoice, LevelSwitched, PopSummary, PopTally, SimCamera, SwitchProbe, SwitchTally,
@@ -164,10 +165,6 @@ struct NearPuckOrWall {
     check_all: bool,
 }
 
-/// Slack on each reach for the rounding of positions summed over a frame's ticks (an f32
-/// position 1,500 m from the centre rounds by about 0.1 mm a tick).
-const REACH_SLACK_M: f32 = 0.01;
-
 /// Whether a creature, at its state at a frame's start, could reach the puck or a wall within
 /// `frame_s`. A planar body's speed between decisions stays below the larger of its speed now
 /// and its top speed (`planar_after` moves it toward a target within the top speed).
@@ -186,13 +183,6 @@ fn could_reach_puck_or_wall(
         || record.touching[Obstacle::Wall as usize]
         || state.position.distance(puck.position) - puck.radius_m - r <= reach + puck_reach_m
         || (state.position.abs() + Vec2::splat(reach + r)).cmpge(half).any()
-}
-
-/// Whether steering, at this decision, saw no other creature near enough to touch this one at
-/// the decision's contact check: its [`Clearance`] is wider than any footprint's reach and a
-/// tick of its motion at `speed_m_per_s` (the index holds where the creatures were before it).
-fn clear_of_creatures(clearance: &Clearance, kind: &KindParams, widest_m: f32, speed_m_per_s: f32, dt: f32) -> bool {
-    clearance.clear_m > kind.radius_m + widest_m + speed_m_per_s * dt + REACH_SLACK_M
 }
 
 /// What says whether anything reads a planar creature before the next decision.
@@ -245,7 +235,7 @@ fn plan_frames(
         let speed = state.velocity.length().max(kind.top_speed_m_per_s);
         frame.behind = choice.wanted == lod
             && !record.touching.iter().any(|&t| t)
-            && clear_of_creatures(clearance, kind, widest_m, speed, clock.dt)
+            && clearance.clear_of_creatures(kind, widest_m, speed, clock.dt)
             && !could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
     };
     for ((creature, state, record, clearance, lod, choice, probed, player), mut frame) in
@@ -372,7 +362,7 @@ fn detect_collisions(
         // (only when every creature is checked, after a respawn or a shove of the puck).
         frame.pose_now(kind, *lod, state, gait, pose);
         // Steering saw no creature near enough to touch now (but a player's creature does not steer).
-        let clear = !player && clear_of_creatures(clearance, kind, widest_m, state.velocity.length(), clock.dt);
+        let clear = !player && clearance.clear_of_creatures(kind, widest_m, state.velocity.length(), clock.dt);
         collide(entity, creature, state, record, (decision && !clear).then_some(&*grid));
         if decision && clear {
             record.note(Obstacle::Creature, false);
@@ -450,7 +440,7 @@ fn respawn_fallen(
     falls: Res<FallQueue>,
     mut tally: ResMut<Tally>,
     mut rng: ResMut<WorldRng>,
-    mut serials: ResMut<SerialCounter>,
+    mut newcomers: ResMut<Newcomers>,
     creatures: Query<(&Creature, &Lod, &CollisionRecord, &LevelChoice, &GaitPhase)>,
 ) {
     let mut fallen = falls.take();
@@ -479,11 +469,12 @@ fn respawn_fallen(
             grid.clearance(p, radius + clear)
                 .min(p.distance(puck.position) - puck_keep_out)
         });
+        newcomers.respawned_at.push(spot);
         commands.entity(entity).despawn();
         commands.spawn(creature_bundle(
             creature.kind,
             &kinds[creature.kind],
-            serials.take(),
+            newcomers.take(),
             *lod,
             spot,
             clock.seconds() as f32,

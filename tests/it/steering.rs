@@ -1,7 +1,10 @@
 //! Steering: creatures escape the puck and keep off the walls and each other.
 
 use crate::support::*;
+use bevy::prelude::*;
 use simlod::config::SimConfig;
+use simlod::contract::{DesiredVelocity, PlanarState};
+use simlod::creature::Clearance;
 use simlod::headless;
 use simlod::outcome::Obstacle;
 
@@ -69,4 +72,126 @@ fn steering_keeps_collisions_with_the_puck_and_walls_low_in_the_default_scenario
         collided_unsteered >= 3 * collided.max(1),
         "unsteered {collided_unsteered} vs steered {collided}"
     );
+}
+
+/// What a watch over every decision's clearances saw.
+#[derive(Resource, Default)]
+struct ClearanceWatch {
+    /// Creature-decisions checked, and of them those between two looks around.
+    checked: u64,
+    waiting: u64,
+    /// Clearances wider than the distance to the nearest other creature.
+    too_wide: Vec<String>,
+}
+
+/// After steering at each decision: each creature's clearance against the nearest other centre,
+/// found by brute force (the positions the index was built from).
+fn watch_clearances(
+    clock: Res<simlod::contract::SimClock>,
+    mut watch: ResMut<ClearanceWatch>,
+    creatures: Query<(&simlod::kind::Creature, &PlanarState, &Clearance), Without<simlod::contract::PlayerControlled>>,
+    everyone: Query<(&simlod::kind::Creature, &PlanarState)>,
+) {
+    if !clock.is_decision_tick() {
+        return;
+    }
+    let decision = clock.decision() as u32;
+    for (c, s, clear) in &creatures {
+        let nearest = (everyone.iter())
+            .filter(|(o, _)| o.serial != c.serial)
+            .map(|(_, o)| o.position.distance(s.position))
+            .fold(f32::INFINITY, f32::min);
+        watch.checked += 1;
+        watch.waiting += u64::from(clear.look_again > decision + 1);
+        if clear.clear_m > nearest + 1e-4 {
+            watch.too_wide.push(format!(
+                "decision {decision}: creature {} clear {} m, nearest {nearest} m",
+                c.serial, clear.clear_m
+            ));
+        }
+    }
+}
+
+/// The clearances watched over `seconds` of `config`, and the creatures that fell.
+fn clearances_over(config: SimConfig, seconds: f64) -> (ClearanceWatch, u64) {
+    let mut sim = simlod::headless::HeadlessSim::new(config);
+    sim.app.init_resource::<ClearanceWatch>().add_systems(
+        FixedUpdate,
+        watch_clearances
+            .after(simlod::contract::SimStage::Steer)
+            .before(simlod::contract::SimStage::SelectLod),
+    );
+    sim.run_for(seconds);
+    let falls = sim.summary(0.0).falls;
+    let watch = sim.app.world_mut().remove_resource::<ClearanceWatch>().unwrap();
+    (watch, falls)
+}
+
+#[test]
+fn a_creature_that_looks_around_rarely_never_claims_more_clearance_than_it_has() {
+    // The contact check passes by a creature whose clearance keeps it clear: between its looks
+    // around, the clearance must shrink at least as fast as the others can close in, and a
+    // creature respawned beside it must wake it. The default game (every level, the puck
+    // knocking creatures over) and a crowd of point masses at ten times the density.
+    let mut crowd = scene(
+        &[("hopper", 300), ("biped", 100)],
+        simlod::lod::LevelPolicy::AllPointMass,
+    );
+    crowd.arena.puck.speed_m_per_s = 6.0;
+    for (config, seconds) in [(default_config(), 20.0), (crowd, 10.0)] {
+        let (watch, falls) = clearances_over(config, seconds);
+        eprintln!(
+            "{} creature-decisions, {} between looks around, {falls} falls",
+            watch.checked, watch.waiting
+        );
+        assert!(
+            watch.too_wide.is_empty(),
+            "{:#?}",
+            &watch.too_wide[..watch.too_wide.len().min(10)]
+        );
+        assert!(watch.waiting * 10 > watch.checked, "the rare looks were exercised");
+        assert!(falls > 0, "respawns were exercised");
+    }
+}
+
+/// How many of `decisions` changed the desired velocity of a lone hopper in open court, looking
+/// around once in `every` decisions when clear.
+fn looks_of_a_lone_hopper(every: u32, decisions: u32) -> u32 {
+    let mut config = scene(&[("hopper", 1)], simlod::lod::LevelPolicy::AllPointMass);
+    config.arena.court_length_m = 400.0;
+    config.arena.court_width_m = 400.0;
+    config.arena.puck.radius_m = 0.05;
+    config.arena.puck.speed_m_per_s = 0.01;
+    for k in &mut config.kinds {
+        k.steering.look_every_decisions_when_clear = every;
+    }
+    let mut sim = simlod::headless::HeadlessSim::new(config);
+    // Far from the puck at the centre and from the walls: it wanders 4 m in the 4 s.
+    let world = sim.app.world_mut();
+    world.query::<&mut PlanarState>().single_mut(world).unwrap().position = Vec2::new(100.0, 100.0);
+    let desired = |sim: &mut simlod::headless::HeadlessSim| {
+        let world = sim.app.world_mut();
+        world.query::<&DesiredVelocity>().single(world).unwrap().0
+    };
+    let mut last = desired(&mut sim);
+    let mut changes = 0;
+    for _ in 0..decisions {
+        sim.advance_frame();
+        let now = desired(&mut sim);
+        changes += u32::from(now != last);
+        last = now;
+    }
+    changes
+}
+
+#[test]
+fn a_creature_with_nothing_within_reach_looks_around_once_in_its_number_of_decisions() {
+    // Its wandering turns it a little at every look: each look changes its desired velocity.
+    assert_eq!(looks_of_a_lone_hopper(1, 120), 120);
+    assert_eq!(looks_of_a_lone_hopper(2, 120), 60);
+    assert_eq!(looks_of_a_lone_hopper(4, 120), 30);
+    // Its clearance reaches as far as it looked (its separation distance, 1.5 m) and shrinks by
+    // 0.21 m a decision: after three waits it must look again to stay clear for the contacts.
+    let every_seven = looks_of_a_lone_hopper(7, 119);
+    assert!((30..=40).contains(&every_seven), "{every_seven} looks");
 }
