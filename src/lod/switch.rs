@@ -84,8 +84,10 @@ fn switch_levels(
     let policy = config.scenario.level_policy;
     let rules_move_levels = policy.is_dynamic();
     // Most ticks nothing switches: one pass over the columns finds the creatures that want
-    // another level or might be forced to rigid (in the query's order, so the switches come in
-    // the same order as a pass over every creature). A creature behind its frame is passed by:
+    // another level or might be forced to rigid, then they switch in the order of their ids, not
+    // the query's: the tables' order moves with components that change nothing simulated (a
+    // blend's), and the order of switches is the order rigid bodies are built and numbered in
+    // rapier, whose rounding follows it. A creature behind its frame is passed by:
     // it wanted its level and touched nothing at the decision, and until the frame's last tick
     // nothing changes either (the choice is made at decisions, and a contact check that finds
     // it first catches it up). Of those that waited for their window last tick, the others let
@@ -106,6 +108,7 @@ fn switch_levels(
             i += 1;
         }
     }
+    attend.sort_unstable();
     for entity in waiting.drain(..) {
         if let Ok((_, _, &lod, choice, _, record, (_, _, _, mut before), _)) = creatures.get_mut(entity)
             && !attends(lod, &choice, record)

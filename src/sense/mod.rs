@@ -306,16 +306,20 @@ impl NeighbourGrid {
     }
 }
 
-/// Sorts `entries` by their cells, stably: by insertion, since an entry out of order is rare
-/// and near its place (a block holds a creature or two).
+/// Sorts `entries` by their cells, and within a cell by serial: by insertion, since an entry out
+/// of order is rare and near its place (a block holds a creature or two). By serial, not in the
+/// query's order, so that a query visits a cell's creatures in the same order however the
+/// tables hold them (a switch's blend moves a creature to another table): sums over neighbours
+/// are then the same bit for bit.
 fn sort_by_cell(entries: &mut [Entry]) {
+    let key = |e: &Entry| (e.cell, e.neighbour.serial);
     for i in 1..entries.len() {
         let e = entries[i];
-        if entries[i - 1].cell <= e.cell {
+        if key(&entries[i - 1]) <= key(&e) {
             continue;
         }
         let mut j = i;
-        while j > 0 && entries[j - 1].cell > e.cell {
+        while j > 0 && key(&entries[j - 1]) > key(&e) {
             entries[j] = entries[j - 1];
             j -= 1;
         }
