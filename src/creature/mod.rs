@@ -16,13 +16,14 @@ use crate::contract::Lod;
 use crate::contract::{SimStart, StartStage, WorldRng};
 use std::collections::HashMap;
 
-/// Hands out creature serials, and keeps where creatures were respawned since the last steering
+/// Hands out creature serials, and keeps where creatures were placed since the last steering
 /// decision: steering wakes a creature that looks around rarely when one lands near it.
 #[derive(Resource, Debug, Default)]
 pub struct Newcomers {
     next_serial: u32,
-    /// Where creatures were respawned since the last decision.
-    pub respawned_at: Vec<Vec2>,
+    /// Where creatures were put since the last decision, other than by their own motion: each
+    /// respawn, and any creature a system of yours moves (push where it put it).
+    pub placed_at: Vec<Vec2>,
 }
 
 impl Newcomers {

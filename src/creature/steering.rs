@@ -166,8 +166,8 @@ pub fn desired_velocity(
     (desired.clamp_length_max(top), Clearance { clear_m, look_again })
 }
 
-/// More respawns than this in a frame wake every creature: each would otherwise test them all.
-const MOST_RESPAWNS_TESTED: usize = 16;
+/// More placements than this in a frame wake every creature: each would otherwise test them all.
+const MOST_PLACEMENTS_TESTED: usize = 16;
 
 /// The puck's heading moving by more than this (the square of the chord between unit headings)
 /// since every creature last looked around wakes them all: a bounce swings its predicted path
@@ -217,11 +217,11 @@ fn steer(
     memory.fastest_m_per_s = fastest;
     let heading = puck.velocity.normalize_or_zero();
     let wake_all = heading.distance_squared(memory.puck_heading) > PUCK_TURN_WAKES
-        || newcomers.respawned_at.len() > MOST_RESPAWNS_TESTED;
+        || newcomers.placed_at.len() > MOST_PLACEMENTS_TESTED;
     if wake_all {
         memory.puck_heading = heading;
     }
-    let respawned_at = std::mem::take(&mut newcomers.respawned_at);
+    let placed_at = std::mem::take(&mut newcomers.placed_at);
     let decision = around.decision as u32;
     let steer_one =
         |creature: &Creature, state: &PlanarState, lod: Lod, desired: &mut DesiredVelocity, clear: &mut Clearance| {
@@ -233,7 +233,7 @@ fn steer(
                     clear_m: clear.clear_m - closed_m,
                     ..*clear
                 };
-                let woken = respawned_at
+                let woken = placed_at
                     .iter()
                     .any(|a| a.distance(state.position) < clear.clear_m + closed_m);
                 if !woken && kept.clear_of_creatures(kind, widest_m, speed_bound, clock.dt) {

@@ -469,7 +469,7 @@ fn respawn_fallen(
             grid.clearance(p, radius + clear)
                 .min(p.distance(puck.position) - puck_keep_out)
         });
-        newcomers.respawned_at.push(spot);
+        newcomers.placed_at.push(spot);
         commands.entity(entity).despawn();
         commands.spawn(creature_bundle(
             creature.kind,

@@ -438,6 +438,13 @@ fn absurd_sizes_masses_speeds_and_rates_are_refused_with_the_unit() {
             "0 and 100 m",
         ),
         (
+            "creatures/biped.ron",
+            "look_every_decisions_when_clear: 4",
+            "look_every_decisions_when_clear: 0",
+            "steering.look_every_decisions_when_clear",
+            "1 to 64, not 0",
+        ),
+        (
             "rules/levels.ron",
             "lookahead_s: 1.0",
             "lookahead_s: 1e20",

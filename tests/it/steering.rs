@@ -154,10 +154,11 @@ fn a_creature_that_looks_around_rarely_never_claims_more_clearance_than_it_has()
     }
 }
 
-/// How many of `decisions` changed the desired velocity of a lone hopper in open court, looking
-/// around once in `every` decisions when clear.
-fn looks_of_a_lone_hopper(every: u32, decisions: u32) -> u32 {
-    let mut config = scene(&[("hopper", 1)], simlod::lod::LevelPolicy::AllPointMass);
+/// `hoppers` hoppers looking around once in `every` decisions when clear, in a court of 400 by
+/// 400 m with a puck too small and slow to alarm anyone; the first at (100, 100), far from the
+/// puck at the centre and from the walls.
+fn open_court(hoppers: u32, every: u32) -> simlod::headless::HeadlessSim {
+    let mut config = scene(&[("hopper", hoppers)], simlod::lod::LevelPolicy::AllPointMass);
     config.arena.court_length_m = 400.0;
     config.arena.court_width_m = 400.0;
     config.arena.puck.radius_m = 0.05;
@@ -166,9 +167,20 @@ fn looks_of_a_lone_hopper(every: u32, decisions: u32) -> u32 {
         k.steering.look_every_decisions_when_clear = every;
     }
     let mut sim = simlod::headless::HeadlessSim::new(config);
-    // Far from the puck at the centre and from the walls: it wanders 4 m in the 4 s.
     let world = sim.app.world_mut();
-    world.query::<&mut PlanarState>().single_mut(world).unwrap().position = Vec2::new(100.0, 100.0);
+    let mut states = world.query::<(&simlod::kind::Creature, &mut PlanarState)>();
+    for (c, mut s) in states.iter_mut(world) {
+        if c.serial == 0 {
+            s.position = Vec2::new(100.0, 100.0);
+        }
+    }
+    sim
+}
+
+/// How many of `decisions` changed the desired velocity of a lone hopper in open court, looking
+/// around once in `every` decisions when clear (it wanders 4 m in the 4 s).
+fn looks_of_a_lone_hopper(every: u32, decisions: u32) -> u32 {
+    let mut sim = open_court(1, every);
     let desired = |sim: &mut simlod::headless::HeadlessSim| {
         let world = sim.app.world_mut();
         world.query::<&DesiredVelocity>().single(world).unwrap().0
@@ -194,4 +206,47 @@ fn a_creature_with_nothing_within_reach_looks_around_once_in_its_number_of_decis
     // 0.21 m a decision: after three waits it must look again to stay clear for the contacts.
     let every_seven = looks_of_a_lone_hopper(7, 119);
     assert!((30..=40).contains(&every_seven), "{every_seven} looks");
+}
+
+#[test]
+fn a_creature_respawned_beside_one_between_its_looks_wakes_it() {
+    // Hopper 0 looks around at decision 0 (its turn) and would wait until decision 4. Then the
+    // other hopper falls and is respawned, as `outcome` does it, 0.8 m from it: at decision 1
+    // its clearance (1.5 m less a decision's closing in) would claim more than it has.
+    let mut sim = open_court(2, 4);
+    sim.app.init_resource::<ClearanceWatch>().add_systems(
+        FixedUpdate,
+        watch_clearances
+            .after(simlod::contract::SimStage::Steer)
+            .before(simlod::contract::SimStage::SelectLod),
+    );
+    sim.advance_frame();
+    let world = sim.app.world_mut();
+    let mut creatures = world.query::<(Entity, &simlod::kind::Creature, &PlanarState, &Clearance)>();
+    let rows: Vec<_> = creatures.iter(world).map(|(e, c, s, cl)| (e, *c, *s, *cl)).collect();
+    let (_, first, state, clearance) = rows.iter().find(|r| r.1.serial == 0).unwrap();
+    assert!(clearance.look_again == 4 && clearance.clear_m > 1.0, "{clearance:?}");
+    let (other, ..) = rows.iter().find(|r| r.1.serial == 1).unwrap();
+    let spot = state.position + Vec2::new(0.8, 0.0);
+    let now = sim.clock().seconds() as f32;
+    let world = sim.app.world_mut();
+    world.despawn(*other);
+    let kinds = world.resource::<simlod::kind::KindTable>().clone();
+    let bundle = world.resource_scope(|_, mut rng: Mut<simlod::contract::WorldRng>| {
+        simlod::creature::creature_bundle(
+            first.kind,
+            &kinds[first.kind],
+            2,
+            simlod::lod::Lod::PointMass,
+            spot,
+            now,
+            &mut rng,
+        )
+    });
+    world.spawn(bundle);
+    world.resource_mut::<simlod::creature::Newcomers>().placed_at.push(spot);
+    sim.advance_frame();
+    let watch = sim.app.world_mut().remove_resource::<ClearanceWatch>().unwrap();
+    assert_eq!(watch.checked, 4, "two decisions of two creatures");
+    assert!(watch.too_wide.is_empty(), "{:#?}", watch.too_wide);
 }
