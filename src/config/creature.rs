@@ -306,7 +306,7 @@ pub struct SteeringConfig {
     pub separation_weight: f32,
     /// Steering's level of detail: a creature with nothing within these reaches (the puck's
     /// path, the walls, another creature) looks around once in this many decisions and keeps
-    /// its desired velocity between; 1 to 64 (1: every decision, as steering did before).
+    /// its desired velocity between; 1 to 64 (1: at every decision; left out, 1).
     #[serde(default = "every_decision")]
     pub look_every_decisions_when_clear: u32,
 }
