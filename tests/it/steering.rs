@@ -112,15 +112,20 @@ fn watch_clearances(
     }
 }
 
-/// The clearances watched over `seconds` of `config`, and the creatures that fell.
-fn clearances_over(config: SimConfig, seconds: f64) -> (ClearanceWatch, u64) {
-    let mut sim = simlod::headless::HeadlessSim::new(config);
+/// Watches every decision's clearances in `sim`, right after steering.
+fn watch(sim: &mut simlod::headless::HeadlessSim) {
     sim.app.init_resource::<ClearanceWatch>().add_systems(
         FixedUpdate,
         watch_clearances
             .after(simlod::contract::SimStage::Steer)
             .before(simlod::contract::SimStage::SelectLod),
     );
+}
+
+/// The clearances watched over `seconds` of `config`, and the creatures that fell.
+fn clearances_over(config: SimConfig, seconds: f64) -> (ClearanceWatch, u64) {
+    let mut sim = simlod::headless::HeadlessSim::new(config);
+    watch(&mut sim);
     sim.run_for(seconds);
     let falls = sim.summary(0.0).falls;
     let watch = sim.app.world_mut().remove_resource::<ClearanceWatch>().unwrap();
@@ -214,12 +219,7 @@ fn a_creature_respawned_beside_one_between_its_looks_wakes_it() {
     // other hopper falls and is respawned, as `outcome` does it, 0.8 m from it: at decision 1
     // its clearance (1.5 m less a decision's closing in) would claim more than it has.
     let mut sim = open_court(2, 4);
-    sim.app.init_resource::<ClearanceWatch>().add_systems(
-        FixedUpdate,
-        watch_clearances
-            .after(simlod::contract::SimStage::Steer)
-            .before(simlod::contract::SimStage::SelectLod),
-    );
+    watch(&mut sim);
     sim.advance_frame();
     let world = sim.app.world_mut();
     let mut creatures = world.query::<(Entity, &simlod::kind::Creature, &PlanarState, &Clearance)>();
