@@ -343,10 +343,8 @@ fn detect_collisions(
                  player: bool,
                  (lod, desired, gait, pose, (frame, segment)): CatchUpItem| {
         if frame.behind {
-            if !puck_outran {
-                return;
-            }
-            // Moved from the frame's start: its stretch begins at the decision's tick.
+            // The puck outran its reach (else the scan passed the creature by). Moved from the
+            // frame's start: its stretch begins at the decision's tick.
             let first_tick = Some(clock.tick - in_frame);
             stepper.follow(
                 creature,
@@ -399,10 +397,18 @@ fn detect_collisions(
         );
         run_chunks(chunks.map(|((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg))))| {
             move || {
-                let rows = ((e.iter().zip(c).zip(cl)).zip(s.iter_mut().zip(r)))
-                    .zip((l.iter().zip(d)).zip((g.iter_mut().zip(p.iter_mut())).zip(f.iter_mut().zip(seg))));
-                for ((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg)))) in rows {
-                    check(*e, c, s, r, cl, player, (l, d, g, p, (f, seg)));
+                // A creature behind its frame is passed by unless the puck outran its reach: the
+                // others are found by a scan of the flags alone (in a crowd nearly all are behind).
+                let next = |f: &[FrameStep], i: usize| match puck_outran {
+                    true => (i < f.len()).then_some(i),
+                    false => FrameStep::next_not_behind(f, i),
+                };
+                let mut i = 0;
+                while let Some(found) = next(f, i) {
+                    i = found;
+                    let caught_up = (&l[i], &d[i], &mut g[i], &mut p[i], (&mut f[i], &mut seg[i]));
+                    check(e[i], &c[i], &mut s[i], &mut r[i], &cl[i], player, caught_up);
+                    i += 1;
                 }
             }
         }));
