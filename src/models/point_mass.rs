@@ -121,6 +121,7 @@ impl Rhythm {
         Self::new(1.0 / kind.cycles_per_s, kind.stance_fraction, kind.steps_per_stride())
     }
 
+    /// Steps of `period_s`, `stance` of each on the ground, `steps` to a stride.
     fn new(period_s: f32, stance: f32, steps: u32) -> Self {
         Self {
             period_s,

@@ -399,15 +399,18 @@ fn detect_collisions(
             move || {
                 // A creature behind its frame is passed by unless the puck outran its reach: the
                 // others are found by a scan of the flags alone (in a crowd nearly all are behind).
-                let next = |f: &[FrameStep], i: usize| match puck_outran {
-                    true => (i < f.len()).then_some(i),
-                    false => FrameStep::next_not_behind(f, i),
+                let next = |f: &[FrameStep], i: usize| {
+                    if puck_outran {
+                        (i < f.len()).then_some(i)
+                    } else {
+                        FrameStep::next_not_behind(f, i)
+                    }
                 };
                 let mut i = 0;
                 while let Some(found) = next(f, i) {
                     i = found;
-                    let caught_up = (&l[i], &d[i], &mut g[i], &mut p[i], (&mut f[i], &mut seg[i]));
-                    check(e[i], &c[i], &mut s[i], &mut r[i], &cl[i], player, caught_up);
+                    let catch_up = (&l[i], &d[i], &mut g[i], &mut p[i], (&mut f[i], &mut seg[i]));
+                    check(e[i], &c[i], &mut s[i], &mut r[i], &cl[i], player, catch_up);
                     i += 1;
                 }
             }
