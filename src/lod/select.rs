@@ -351,6 +351,13 @@ fn place_camera(
 #[derive(Resource, Default)]
 pub struct LevelsSettled(bool);
 
+impl LevelsSettled {
+    /// Whether selecting and switching rest: a fixed policy's levels are all reached.
+    pub fn at_rest(&self) -> bool {
+        self.0
+    }
+}
+
 /// Levels may change: under a rule-based policy always; under a fixed one until every
 /// creature has reached it (at the start, or after the policy changed during a game).
 pub fn levels_may_change(config: Res<SimConfig>, settled: Res<LevelsSettled>) -> bool {
@@ -403,11 +410,13 @@ pub(super) fn select_levels(
             choice.wanted = wanted;
         }
     });
-    // Not settled while a creature dwells: its wanted level may still change when the dwell ends.
+    // Under a fixed policy levels rest once every creature is at the policy's level for its
+    // kind: none can want another then (a dwell only holds back a creature not yet there, and
+    // a world starts at its levels).
     settled.0 = !policy.is_dynamic()
         && creatures
             .iter()
-            .all(|(_, lod, _, choice)| *lod == choice.wanted && now - choice.last_switch_s >= rules.min_dwell_s);
+            .all(|(c, lod, s, _)| *lod == kinds[c.kind].best_level(levels.level(policy, c, s, &enter)));
 }
 
 /// A new world's creatures, placed as point masses, start at the level the policy gives them

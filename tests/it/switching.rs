@@ -10,7 +10,7 @@ use simlod::config::SimConfig;
 use simlod::creature::{Creature, PlanarState};
 use simlod::gait::GaitPose;
 use simlod::headless::HeadlessSim;
-use simlod::lod::{Drawn, LevelPolicy, LevelSwitched, Lod, SimCamera};
+use simlod::lod::{Drawn, LevelPolicy, LevelSwitched, LevelsSettled, Lod, SimCamera};
 use simlod::models::rigid::{RigidBodies, RigidPart};
 use simlod::outcome::CollisionRecord;
 use simlod::{SimClock, SimStage};
@@ -461,6 +461,9 @@ fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests()
     sim.run_for(3.0);
     let changed_at = sim.clock().seconds() as f32;
     sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = LevelPolicy::AllPointMass;
+    sim.advance_frame();
+    let at_rest = |sim: &HeadlessSim| sim.app.world().resource::<LevelsSettled>().at_rest();
+    assert!(!at_rest(&sim), "creatures above the point mass still to switch");
     sim.run_for(3.0);
     let levels = |sim: &mut HeadlessSim| {
         let world = sim.app.world_mut();
@@ -479,10 +482,30 @@ fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests()
         assert!(o.switch.flight_progress.is_some(), "{:?} skipped the window", o.switch);
     }
     // Settled: nothing left to select or switch.
+    assert!(at_rest(&sim));
     let switches = seen.len();
     sim.run_for(2.0);
     assert_eq!(sim.app.world().resource::<Watch>().seen.len(), switches);
     assert!(levels(&mut sim).iter().all(|l| *l == Lod::PointMass));
+}
+
+#[test]
+fn a_game_under_a_fixed_policy_rests_from_its_first_decision() {
+    // A world starts at its levels: nothing to select or switch, though no creature has yet
+    // been at its level for the dwell.
+    for policy in [LevelPolicy::AllPointMass, LevelPolicy::AllHybrid, LevelPolicy::AllRigid] {
+        let mut config = default_config();
+        config.scenario.level_policy = policy;
+        let dwell_s = f64::from(config.rules.min_dwell_s);
+        let mut sim = HeadlessSim::new(config);
+        sim.advance_frame();
+        assert!(sim.clock().seconds() < dwell_s, "within the dwell");
+        assert!(sim.app.world().resource::<LevelsSettled>().at_rest(), "{policy:?}");
+    }
+    // The rules keep choosing.
+    let mut sim = HeadlessSim::new(influence_config());
+    sim.run_for(2.0);
+    assert!(!sim.app.world().resource::<LevelsSettled>().at_rest());
 }
 
 /// The camera's facing at the end of each tick.
