@@ -71,7 +71,7 @@ pub struct NeighbourGrid {
     /// Blocks of [`BLOCK_CELLS`] cells along a row, per row.
     block_cols: u32,
     /// `block_start[b]..block_start[b + 1]` are the entries of block `b` (row by row), in the
-    /// order of their cells, and in input order within a cell.
+    /// order of their cells, and in serial order within a cell.
     block_start: Vec<u32>,
     entries: Vec<Entry>,
     /// Scratch, kept to avoid an allocation per rebuild: each input's block and cell.
@@ -160,8 +160,8 @@ impl NeighbourGrid {
         (self.fastest_m_per_s, self.widest_radius_m) = widest
             .iter_mut()
             .fold((0.0f32, 0.0f32), |(f, w), fw| (f.max(fw.0), w.max(fw.1)));
-        // The blocks in a range a core, which counts, fills in input order and sorts by cell
-        // its own: each core reads every key and takes its range's.
+        // The blocks in a range a core, which counts, fills in input order and sorts by cell and
+        // serial its own: each core reads every key and takes its range's.
         let blocks = self.block_start.len() - 1;
         let ranges = len.div_ceil(n).max(1);
         let edge: Vec<usize> = (0..=ranges).map(|r| r * blocks / ranges).collect();
