@@ -321,28 +321,40 @@ impl<'a> PlanarStepper<'a> {
         ticks: u64,
         posed: bool,
     ) {
+        self.move_plane(creature, lod, desired, state, ticks);
+        self.move_gait(creature, lod, (state, gait, pose), ticks, posed);
+    }
+
+    /// [`PlanarStepper::advance`]'s first half: the body on the plane.
+    fn move_plane(&self, creature: &Creature, lod: Lod, desired: Vec2, state: &mut PlanarState, ticks: u64) {
         let kind = &self.kinds[creature.kind];
-        let table = match (lod, &kind.gait) {
-            (Lod::Hybrid, Some(table)) => Some(table),
-            // A hybrid whose kind has no table is not made: `KindParams::best_level`.
-            (Lod::Hybrid, None) => return,
-            _ => None,
-        };
-        let (turns, point_mass) = &self.per_kind[creature.kind];
+        // A hybrid whose kind has no table is not made: `KindParams::best_level`.
+        if lod == Lod::Hybrid && kind.gait.is_none() {
+            return;
+        }
+        let turns = &self.per_kind[creature.kind].0;
         // A stretch ends at the next decision: never more ticks than a decision's.
         debug_assert!((1..=turns.len() as u64).contains(&ticks), "{ticks} ticks");
         let ticks = ticks.clamp(1, turns.len() as u64) as u32;
         *state = planar_after(state, desired, kind, &turns[ticks as usize - 1], ticks, self.clock.dt);
-        let seconds = ticks as f32 * self.clock.dt;
-        match table {
-            Some(table) => {
+    }
+
+    /// [`PlanarStepper::advance`]'s second half, once the body has moved: the gait's rhythm at
+    /// the body's new speed, and the pose.
+    fn move_gait(&self, creature: &Creature, lod: Lod, (state, gait, pose): Moving, ticks: u64, posed: bool) {
+        let kind = &self.kinds[creature.kind];
+        let (turns, point_mass) = &self.per_kind[creature.kind];
+        let seconds = ticks.clamp(1, turns.len() as u64) as f32 * self.clock.dt;
+        match (lod, &kind.gait) {
+            (Lod::Hybrid, Some(table)) => {
                 let at = table.at(state.velocity.length());
                 *gait = Rhythm::of_table(table, &at).advance(gait, seconds, self.end_s);
                 if posed {
                     *pose = hybrid::pose(gait, &at, table.steps_per_stride);
                 }
             }
-            None => *gait = point_mass.advance(gait, seconds, self.end_s),
+            (Lod::Hybrid, None) => {}
+            _ => *gait = point_mass.advance(gait, seconds, self.end_s),
         }
     }
 
@@ -393,26 +405,16 @@ pub(crate) fn step_point_masses(
     let stepper = PlanarStepper::new(&kinds, &clock);
     let in_frame = clock.tick_in_frame();
     let last_of_frame = in_frame + 1 == u64::from(clock.ticks_per_decision);
-    let step = |creature: &Creature,
-                lod: Lod,
-                desired: Vec2,
-                moving: Moving<'_>,
-                frame: &mut FrameStep,
-                segment: &mut PlanarSegment| {
-        if frame.behind {
-            if last_of_frame {
-                // Nothing reads it before the next decision: its pose waits for a reader.
-                *frame = FrameStep {
-                    behind: false,
-                    pose_stale: true,
-                };
-                stepper.advance(creature, lod, desired, moving, in_frame + 1, false);
-            }
-        } else {
-            let first_tick = (in_frame == 0).then_some(clock.tick);
-            stepper.follow(creature, lod, desired, moving, (frame, segment), first_tick);
-        }
+    let follow = |creature: &Creature,
+                  lod: Lod,
+                  desired: Vec2,
+                  moving: Moving<'_>,
+                  frame: &mut FrameStep,
+                  segment: &mut PlanarSegment| {
+        let first_tick = (in_frame == 0).then_some(clock.tick);
+        stepper.follow(creature, lod, desired, moving, (frame, segment), first_tick);
     };
+    let (stepper, follow) = (&stepper, &follow);
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
     // of each creature's components one by one cost more than the step itself.
     for ((creature, lod, desired), (mut state, mut gait, mut pose), (mut frame, mut segment)) in
@@ -434,28 +436,51 @@ pub(crate) fn step_point_masses(
                     let mut i = 0;
                     while let Some(next) = FrameStep::next_not_behind(f, i) {
                         i = next;
-                        step(
-                            &c[i],
-                            l[i],
-                            d[i].0,
-                            (&mut s[i], &mut g[i], &mut p[i]),
-                            &mut f[i],
-                            &mut seg[i],
-                        );
+                        let moving = (&mut s[i], &mut g[i], &mut p[i]);
+                        follow(&c[i], l[i], d[i].0, moving, &mut f[i], &mut seg[i]);
                         i += 1;
                     }
                     return;
                 }
-                let rows = (c.iter().zip(l).zip(d))
-                    .zip((s.iter_mut().zip(g)).zip(p.iter_mut()))
-                    .zip(f.iter_mut().zip(seg));
-                for ((((c, l), d), ((s, g), p)), (f, seg)) in rows {
-                    step(c, *l, d.0, (s, g, p), f, seg);
+                // The frame's last tick: the creatures behind move the whole frame (nothing reads
+                // their poses before the next decision: they wait for a reader), the others their
+                // stretch. A block at a time, every body on the plane first, then every gait: a
+                // hybrid's gait waits on its new speed, and so one creature's roots and divisions
+                // run beside the next's, not after them.
+                let blocks = (c.chunks(CATCH_UP_BLOCK).zip(l.chunks(CATCH_UP_BLOCK)))
+                    .zip(d.chunks(CATCH_UP_BLOCK).zip(s.chunks_mut(CATCH_UP_BLOCK)))
+                    .zip(g.chunks_mut(CATCH_UP_BLOCK).zip(p.chunks_mut(CATCH_UP_BLOCK)))
+                    .zip(f.chunks_mut(CATCH_UP_BLOCK).zip(seg.chunks_mut(CATCH_UP_BLOCK)));
+                let ticks = in_frame + 1;
+                for ((((c, l), (d, s)), (g, p)), (f, seg)) in blocks {
+                    for (((c, l), (d, s)), f) in c.iter().zip(l).zip(d.iter().zip(s.iter_mut())).zip(f.iter()) {
+                        if f.behind {
+                            stepper.move_plane(c, *l, d.0, s, ticks);
+                        }
+                    }
+                    let rows = (c.iter().zip(l).zip(d))
+                        .zip((s.iter_mut().zip(g)).zip(p.iter_mut()))
+                        .zip(f.iter_mut().zip(seg));
+                    for ((((c, l), d), ((s, g), p)), (f, seg)) in rows {
+                        if f.behind {
+                            *f = FrameStep {
+                                behind: false,
+                                pose_stale: true,
+                            };
+                            stepper.move_gait(c, *l, (s, g, p), ticks, false);
+                        } else {
+                            follow(c, *l, d.0, (s, g, p), f, seg);
+                        }
+                    }
                 }
             }
         }));
     }
 }
+
+/// Creatures a catch-up moves on the plane before it moves their gaits: a few lines of the
+/// cache of each column.
+const CATCH_UP_BLOCK: usize = 64;
 
 pub(super) fn plugin(app: &mut App) {
     let schedule = SimClock::schedule_of(app);
