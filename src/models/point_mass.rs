@@ -325,6 +325,14 @@ impl<'a> PlanarStepper<'a> {
         self.move_gait(creature, lod, (state, gait, pose), ticks, posed);
     }
 
+    /// `ticks` of a stretch as the step takes them: a stretch ends at the next decision, so
+    /// never more than a decision's.
+    fn stretch_ticks(&self, ticks: u64) -> u32 {
+        let most = self.clock.ticks_per_decision.max(1);
+        debug_assert!((1..=u64::from(most)).contains(&ticks), "{ticks} ticks");
+        ticks.clamp(1, u64::from(most)) as u32
+    }
+
     /// [`PlanarStepper::advance`]'s first half: the body on the plane.
     fn move_plane(&self, creature: &Creature, lod: Lod, desired: Vec2, state: &mut PlanarState, ticks: u64) {
         let kind = &self.kinds[creature.kind];
@@ -332,19 +340,17 @@ impl<'a> PlanarStepper<'a> {
         if lod == Lod::Hybrid && kind.gait.is_none() {
             return;
         }
-        let turns = &self.per_kind[creature.kind].0;
-        // A stretch ends at the next decision: never more ticks than a decision's.
-        debug_assert!((1..=turns.len() as u64).contains(&ticks), "{ticks} ticks");
-        let ticks = ticks.clamp(1, turns.len() as u64) as u32;
-        *state = planar_after(state, desired, kind, &turns[ticks as usize - 1], ticks, self.clock.dt);
+        let ticks = self.stretch_ticks(ticks);
+        let turn = &self.per_kind[creature.kind].0[ticks as usize - 1];
+        *state = planar_after(state, desired, kind, turn, ticks, self.clock.dt);
     }
 
     /// [`PlanarStepper::advance`]'s second half, once the body has moved: the gait's rhythm at
     /// the body's new speed, and the pose.
     fn move_gait(&self, creature: &Creature, lod: Lod, (state, gait, pose): Moving, ticks: u64, posed: bool) {
         let kind = &self.kinds[creature.kind];
-        let (turns, point_mass) = &self.per_kind[creature.kind];
-        let seconds = ticks.clamp(1, turns.len() as u64) as f32 * self.clock.dt;
+        let point_mass = &self.per_kind[creature.kind].1;
+        let seconds = self.stretch_ticks(ticks) as f32 * self.clock.dt;
         match (lod, &kind.gait) {
             (Lod::Hybrid, Some(table)) => {
                 let at = table.at(state.velocity.length());
