@@ -224,39 +224,39 @@ impl Step {
         (u64::from(descending) << serial_bits) | u64::from(self.serial)
     }
 
-    /// Sorts `steps` into the order they are taken, by their key: radix sorts, stable (so each
-    /// creature's steps stay in the order of its hull). `most_serial` is the largest serial.
-    fn sort(steps: &mut Vec<Step>, most_serial: u32) {
-        let serial_bits = u32::BITS - most_serial.leading_zeros();
+    /// The bits the order key gives the serial, for serials up to `most_serial`.
+    fn serial_bits(most_serial: u32) -> u32 {
+        u32::BITS - most_serial.leading_zeros()
+    }
+
+    /// Sorts `steps` into the order they are taken, by their key: a radix sort, stable (so
+    /// each creature's steps stay in the order of its hull).
+    fn sort(steps: &mut [Step], serial_bits: u32) {
+        radsort::sort_by_key(steps, |s| s.order_key(serial_bits));
+    }
+
+    /// Lists each sorted by [`Step::sort`], merged into the order one stable sort of them end
+    /// to end gives: the earlier list's first among equal keys.
+    fn merge(lists: Vec<Vec<Step>>, serial_bits: u32) -> Vec<Step> {
         let key = |s: &Step| s.order_key(serial_bits);
-        if steps.len() < 2 * SORT_HALF_STEPS {
-            radsort::sort_by_key(steps, key);
-            return;
-        }
-        // Two halves sorted across the cores, then merged, the first half's first among equal
-        // keys: the order one stable sort gives.
-        let mid = steps.len() / 2;
-        let (first, second) = steps.split_at_mut(mid);
-        run_chunks(
-            [first, second]
-                .into_iter()
-                .map(|half| move || radsort::sort_by_key(half, key)),
-        );
-        let (first, second) = steps.split_at(mid);
-        let mut merged = Vec::with_capacity(steps.len());
-        let (mut i, mut j) = (0, 0);
-        while i < first.len() && j < second.len() {
-            if key(&second[j]) < key(&first[i]) {
-                merged.push(second[j]);
-                j += 1;
-            } else {
-                merged.push(first[i]);
-                i += 1;
+        let mut lists = lists.into_iter();
+        let first = lists.next().unwrap_or_default();
+        lists.fold(first, |first, second| {
+            let mut merged = Vec::with_capacity(first.len() + second.len());
+            let (mut i, mut j) = (0, 0);
+            while i < first.len() && j < second.len() {
+                if key(&second[j]) < key(&first[i]) {
+                    merged.push(second[j]);
+                    j += 1;
+                } else {
+                    merged.push(first[i]);
+                    i += 1;
+                }
             }
-        }
-        merged.extend_from_slice(&first[i..]);
-        merged.extend_from_slice(&second[j..]);
-        *steps = merged;
+            merged.extend_from_slice(&first[i..]);
+            merged.extend_from_slice(&second[j..]);
+            merged
+        })
     }
 }
 
@@ -303,36 +303,32 @@ pub fn allocate<S: Send>(
         least_per_us,
         settle_us,
     };
-    // In one pass over the creatures: each one's floor, whether it is settled (beside the
-    // levels: the queue's order is not the creatures', and a look at a creature for each step
-    // that waits in it would miss the cache), what the floors cost and what the frame as it
-    // will run costs (creatures going down still cost their level: a search is paid for at
-    // once and never given back, so it must fit beside that too), the cheapest step of all,
-    // and every creature's steps up its hull (two at most).
-    let mut levels = Vec::with_capacity(candidates.len());
-    let mut settled_now = Vec::with_capacity(candidates.len());
-    let (mut spent, mut running_us, mut cheapest_us) = (0.0f32, 0.0f32, f32::INFINITY);
-    let mut listed = Vec::with_capacity(2 * candidates.len());
-    // Where every level costs no less than the one below, what is spent and the frame as it
-    // will run only grow, so a step that cannot fit now never will and may be passed by.
-    let mut rising = true;
-    let mut most_serial = 0;
-    for (i, c) in candidates.iter().enumerate() {
-        rising &= c.costs.rise_with_level();
-        most_serial = most_serial.max(c.serial);
-        levels.push(c.floor);
-        settled_now.push(c.settled);
-        let p = c.priced(hull.hysteresis);
-        spent += p.cost_us[c.floor as usize];
-        running_us += p.cost_us[c.floor.max(c.current) as usize];
-        cheapest_us = cheapest_us.min(c.cheapest_step_above_floor_us(&p));
-        c.list_hull(i as u32, &hull, &p, &mut listed);
-    }
-    // Best first (`Step::sort`); after a search, the searched creature's steps (few) wait in
-    // a heap beside them.
-    if spent + cheapest_us <= budget_us {
-        Step::sort(&mut listed, most_serial);
-    } else {
+    let mut floors = Floors::with_capacity(candidates.len());
+    candidates.iter().for_each(|c| floors.add(c.into(), c.serial));
+    let listed = hull.list(candidates, 0, Step::serial_bits(floors.most_serial));
+    let settled_now = candidates.iter().map(|c| c.settled).collect();
+    allocate_listed(candidates, floors, settled_now, listed, budget_us, &hull, settle)
+}
+
+/// [`allocate`] from every creature at its floor (`floors`), whether each is `settled_now`, and
+/// the steps up their hulls `listed` in the order they are taken ([`Hull::list`]).
+fn allocate_listed<S: Send>(
+    candidates: &mut [Candidate],
+    floors: Floors,
+    mut settled_now: Vec<bool>,
+    mut listed: Vec<Step>,
+    budget_us: f32,
+    hull: &Hull,
+    settle: impl Fn(usize) -> (f32, S) + Sync,
+) -> Allocation<S> {
+    // What the floors cost and what the frame as it will run costs (creatures going down still
+    // cost their level: a search is paid for at once and never given back, so it must fit
+    // beside that too), and the cheapest step of all. Where every level costs no less than the
+    // one below, what is spent and the frame as it will run only grow, so a step that cannot
+    // fit now never will and may be passed by.
+    let (mut levels, mut spent, mut running_us) = (floors.levels, floors.cost_us, floors.frame_us);
+    let (cheapest_us, rising, settle_us) = (floors.cheapest_step_us, floors.rising, hull.settle_us);
+    if spent + cheapest_us > budget_us {
         listed.clear();
     }
     // The least room any listed step from each on needs, and any exact one: once the budget
@@ -384,7 +380,7 @@ pub fn allocate<S: Send>(
             if searches_fit && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
-                let now = ahead.take(next - 1, &listed, candidates, &settled_now, &hull, room_us, &settle);
+                let now = ahead.take(next - 1, &listed, candidates, &settled_now, hull, room_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
                 settled.push((creature, now.kept));
@@ -401,7 +397,7 @@ pub fn allocate<S: Send>(
             // A listed step's successor is listed too.
             if followed {
                 let c = &candidates[creature];
-                follows.push(c.step_from(step.creature, step.to, &hull, &c.priced(hull.hysteresis)));
+                follows.push(c.step_from(step.creature, step.to, hull, &c.priced(hull.hysteresis)));
             }
         }
     }
@@ -469,6 +465,20 @@ struct Hull {
     hysteresis: f32,
     least_per_us: f32,
     settle_us: f32,
+}
+
+impl Hull {
+    /// Every step up the hulls of `candidates` (the first of them the `first` creature) in the
+    /// order they are taken: a creature's steps in turn, then sorted ([`Step::sort`]). A chunk
+    /// of the creatures can be listed apart and the chunks merged ([`Step::merge`]).
+    fn list(&self, candidates: &[Candidate], first: u32, serial_bits: u32) -> Vec<Step> {
+        let mut listed = Vec::with_capacity(2 * candidates.len());
+        for (i, c) in (first..).zip(candidates) {
+            c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
+        }
+        Step::sort(&mut listed, serial_bits);
+        listed
+    }
 }
 
 /// A bound settled: the exact benefit, what the caller keeps of the settling, and the
@@ -555,10 +565,6 @@ impl<S: Send> SettledAhead<S> {
 /// The most bounds settled ahead at once.
 const MAX_SETTLED_AHEAD: usize = 4096;
 
-/// Below twice this many steps, the knapsack's list is sorted in one piece. A guess at where a
-/// second core starts to pay (measured only at 172,000 steps, where it saves a fifth).
-const SORT_HALF_STEPS: usize = 16_384;
-
 /// Every creature at its floor, gathered one by one before any benefit is worked out: what
 /// the floors cost, and whether any creature's cheapest step up fits beside them (if not,
 /// [`allocate`] gives every creature its floor, so they are the choice).
@@ -570,6 +576,10 @@ struct Floors {
     frame_us: f32,
     /// The cheapest step up from any floor, us.
     cheapest_step_us: f32,
+    /// Whether every creature's levels cost no less than the one below.
+    rising: bool,
+    /// The largest serial.
+    most_serial: u32,
 }
 
 /// What one creature at its floor adds to [`Floors`]: the same for every creature of its kind
@@ -580,6 +590,7 @@ struct AtFloor {
     cost_us: f32,
     frame_us: f32,
     cheapest_step_us: f32,
+    rising: bool,
 }
 
 impl From<&Candidate<'_>> for AtFloor {
@@ -589,6 +600,7 @@ impl From<&Candidate<'_>> for AtFloor {
             cost_us: c.cost_us(c.floor),
             frame_us: c.frame_cost_us(c.floor),
             cheapest_step_us: c.cheapest_step_above_floor_us(&c.priced(0.0)),
+            rising: c.costs.rise_with_level(),
         }
     }
 }
@@ -600,14 +612,18 @@ impl Floors {
             cost_us: 0.0,
             frame_us: 0.0,
             cheapest_step_us: f32::INFINITY,
+            rising: true,
+            most_serial: 0,
         }
     }
 
-    fn add(&mut self, c: AtFloor) {
+    fn add(&mut self, c: AtFloor, serial: u32) {
         self.levels.push(c.floor);
         self.cost_us += c.cost_us;
         self.frame_us += c.frame_us;
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
+        self.rising &= c.rising;
+        self.most_serial = self.most_serial.max(serial);
     }
 
     fn any_step_fits(&self, budget_us: f32) -> bool {
@@ -1070,7 +1086,7 @@ fn decide(
         .collect();
     let mut floors = Floors::with_capacity(creatures.iter().len());
     for (_, c, &lod, _, choice) in creatures {
-        floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
+        floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize], c.serial);
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
@@ -1087,30 +1103,45 @@ fn decide(
         .map(|&(_, c, &lod, _, choice)| candidate(c, lod, choice))
         .collect();
     let rules = &config.rules.budget;
-    let (hysteresis, least_per_us) = (rules.hysteresis, rules.least_benefit_per_ms / 1e3);
-    // Each creature's bounds are its own, worked out across the cores.
+    let hull = Hull {
+        hysteresis: rules.hysteresis,
+        least_per_us: rules.least_benefit_per_ms / 1e3,
+        settle_us: config.costs.contact_search_us,
+    };
+    let serial_bits = Step::serial_bits(floors.most_serial);
+    // Each creature's bounds and steps are its own, worked out and listed across the cores,
+    // each chunk's steps sorted while they are at hand, then merged.
     let mut bounds = vec![Bounds::default(); rows.len()];
+    let mut settled_now = vec![false; rows.len()];
     let n = chunk_len(config.scenario.creature_count(), rows.len());
+    let mut chunks = vec![Vec::new(); rows.len().div_ceil(n)];
     run_chunks(
-        rows.chunks(n)
-            .zip(candidates.chunks_mut(n))
-            .zip(bounds.chunks_mut(n))
-            .map(|((rows, candidates), bounds)| {
+        (rows.chunks(n).zip(candidates.chunks_mut(n)))
+            .zip(bounds.chunks_mut(n).zip(settled_now.chunks_mut(n)))
+            .zip(chunks.iter_mut().zip((0..).step_by(n)))
+            .map(|(((rows, candidates), (bounds, settled_now)), (listed, first))| {
+                let hull = &hull;
                 move || {
-                    for ((&(entity, c, _, s, choice), candidate), bound) in rows.iter().zip(candidates).zip(bounds) {
+                    let creatures = rows
+                        .iter()
+                        .zip(candidates.iter_mut())
+                        .zip(bounds.iter_mut().zip(settled_now));
+                    for ((&(entity, c, _, s, choice), candidate), (bound, settled)) in creatures {
                         *bound = scene.bounds(entity, s, &kinds[c.kind]);
                         // A search within `contact_recheck_s` stands; without one, any
                         // contact with another creature could be now.
                         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
                         candidate.benefit = [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))];
                         candidate.settled = standing.is_some() || bound.settled(scene);
+                        *settled = candidate.settled;
                     }
+                    *listed = hull.list(candidates, first, serial_bits);
                 }
             }),
     );
+    let listed = Step::merge(chunks, serial_bits);
     // Only a creature that could still buy a level is searched for contacts with the others.
-    let search_us = config.costs.contact_search_us;
-    let mut allocation = allocate(&mut candidates, room_us, hysteresis, least_per_us, search_us, |i| {
+    let mut allocation = allocate_listed(&mut candidates, floors, settled_now, listed, room_us, &hull, |i| {
         let (_, c, _, s, _) = rows[i];
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
         (bounds[i].rigid(scene, urgency), urgency)
@@ -1296,7 +1327,7 @@ mod tests {
 
     fn floors_of(crowd: &[Candidate]) -> Floors {
         let mut floors = Floors::with_capacity(crowd.len());
-        crowd.iter().for_each(|c| floors.add(c.into()));
+        crowd.iter().for_each(|c| floors.add(c.into(), c.serial));
         floors
     }
 
@@ -1665,8 +1696,7 @@ mod tests {
     fn steps_sorted_by_their_key_are_in_the_order_they_are_taken() {
         let mut next = uniform(3);
         let ratios = [0.0, 1e-30, 0.006, 0.5, 7.0, f32::INFINITY];
-        bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
-        // In one piece, and in halves across the cores.
+        // In one piece, and in chunks sorted apart and merged.
         for (most_serial, count) in [(5u32, 4000), (1000, 4000), (100_000, 40_000), (u32::MAX, 40_001)] {
             let mut steps: Vec<Step> = (0..count)
                 .map(|i| {
@@ -1689,13 +1719,25 @@ mod tests {
                     }
                 })
                 .collect();
-            Step::sort(&mut steps, most_serial);
-            assert!(
-                steps
-                    .windows(2)
-                    .all(|w| w[0] > w[1] || (w[0] == w[1] && w[0].creature < w[1].creature)),
-                "up to serial {most_serial}"
-            );
+            let serial_bits = Step::serial_bits(most_serial);
+            let chunks = steps
+                .chunks(count as usize / 3 + 1)
+                .map(|chunk| {
+                    let mut chunk = chunk.to_vec();
+                    Step::sort(&mut chunk, serial_bits);
+                    chunk
+                })
+                .collect();
+            let merged = Step::merge(chunks, serial_bits);
+            Step::sort(&mut steps, serial_bits);
+            for steps in [steps, merged] {
+                assert!(
+                    steps
+                        .windows(2)
+                        .all(|w| w[0] > w[1] || (w[0] == w[1] && w[0].creature < w[1].creature)),
+                    "up to serial {most_serial}"
+                );
+            }
         }
     }
 
