@@ -142,10 +142,10 @@ impl Candidate<'_> {
 
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
-    fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, listed: &mut Vec<Step>) {
+    fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, listed: &mut Listing) {
         let mut next = self.step_from(creature, self.floor, hull, p);
         while let Some(step) = next {
-            listed.push(step);
+            listed.push(step, hull);
             next = self.step_from(creature, step.to, hull, p);
         }
     }
@@ -303,20 +303,33 @@ pub fn allocate<S: Send>(
         least_per_us,
         settle_us,
     };
+    list_and_allocate(candidates, budget_us, &hull, None, settle)
+}
+
+/// [`allocate`], its steps dear beyond `dear_us` if given ([`Floors::dear_us`] if not).
+fn list_and_allocate<S: Send>(
+    candidates: &mut [Candidate],
+    budget_us: f32,
+    hull: &Hull,
+    dear_us: Option<f32>,
+    settle: impl Fn(usize) -> (f32, S) + Sync,
+) -> Allocation<S> {
     let mut floors = Floors::with_capacity(candidates.len());
     candidates.iter().for_each(|c| floors.add(c.into(), c.serial));
-    let listed = hull.list(candidates, 0, Step::serial_bits(floors.most_serial));
+    let dear_us = dear_us.unwrap_or_else(|| floors.dear_us(budget_us));
+    let listed = hull.list(candidates, 0, Step::serial_bits(floors.most_serial), dear_us);
     let settled_now = candidates.iter().map(|c| c.settled).collect();
-    allocate_listed(candidates, floors, settled_now, listed, budget_us, &hull, settle)
+    allocate_listed(candidates, floors, settled_now, listed, budget_us, hull, settle)
 }
 
 /// [`allocate`] from every creature at its floor (`floors`), whether each is `settled_now`, and
-/// the steps up their hulls `listed` in the order they are taken ([`Hull::list`]).
+/// the steps up their hulls `listed` ([`Hull::list`], its dear steps beyond the room in the
+/// budget the floors leave over [`DEAR_STEPS`]).
 fn allocate_listed<S: Send>(
     candidates: &mut [Candidate],
     floors: Floors,
     mut settled_now: Vec<bool>,
-    mut listed: Vec<Step>,
+    listed: Listing,
     budget_us: f32,
     hull: &Hull,
     settle: impl Fn(usize) -> (f32, S) + Sync,
@@ -328,59 +341,84 @@ fn allocate_listed<S: Send>(
     // fit now never will and may be passed by.
     let (mut levels, mut spent, mut running_us) = (floors.levels, floors.cost_us, floors.frame_us);
     let (cheapest_us, rising, settle_us) = (floors.cheapest_step_us, floors.rising, hull.settle_us);
-    if spent + cheapest_us > budget_us {
-        listed.clear();
+    // The queue: the lists of steps, merged as it goes, best first.
+    let threads = threads_for(candidates.len() as u32);
+    let mut lists: Vec<Queued<S>> = Vec::new();
+    if spent + cheapest_us <= budget_us {
+        lists.push(Queued::cheap(listed.cheap, hull, threads));
+        lists.extend(
+            listed
+                .dear
+                .into_iter()
+                .map(|(_, steps)| Queued::dear(steps, hull, threads)),
+        );
     }
-    // The least room any listed step from each on needs, and any exact one: once the budget
-    // has less (or no search fits beside the frame as it will run, which only grows), the rest
-    // of the list can change nothing and is passed by.
-    let mut need_from = vec![(f32::INFINITY, f32::INFINITY); listed.len() + 1];
-    for (i, step) in listed.iter().enumerate().rev() {
-        let (any, exact) = need_from[i + 1];
-        // A bound needs room for its search too.
-        let (any_need, exact_need) = if step.bound {
-            (settle_us + step.extra_us, f32::INFINITY)
-        } else {
-            (step.extra_us, step.extra_us)
-        };
-        need_from[i] = (any.min(any_need), exact.min(exact_need));
-    }
-    let mut next = 0;
+    // The list last taken from, and the best next step of the others then: it is taken from
+    // while its next step is above that.
+    let mut run: Option<(usize, Option<Step>)> = None;
     let mut follows = Follows::default();
-    let mut ahead = SettledAhead::new(threads_for(candidates.len() as u32));
     let (mut taken, mut settled) = (Vec::new(), Vec::new());
     loop {
         let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
-        let first = listed.get(next).filter(|_| {
-            let (any, exact) = need_from[next];
+        // Whether a list's next step could fit, or any after it (once the budget has less, or
+        // no search fits beside the frame as it will run, which only grows, the rest of the
+        // list can change nothing and is passed by).
+        let live = |q: &Queued<S>| {
+            let (any, exact) = q.needs();
             !rising || spent + if searches_fit { any } else { exact } <= budget_us
+        };
+        // (Steps are compared where they lie, not copied: a copy read back soon after it is
+        // written stalls the loop.)
+        let running_on = run.and_then(|(i, others)| {
+            let q = &mut lists[i];
+            (live(q) && q.head().is_some_and(|h| others.is_none_or(|o| *h > o))).then_some(i)
         });
-        let (step, followed) = match (first, follows.heap.peek()) {
-            (Some(first), Some(follow)) if follow > first => (follows.heap.pop(), true),
-            (Some(&first), _) => {
-                next += 1;
-                (Some(first), false)
+        let first = running_on.or_else(|| {
+            let (mut best, mut others) = (None::<(usize, Step)>, None);
+            for (i, q) in lists.iter_mut().enumerate() {
+                if !live(q) {
+                    continue;
+                }
+                let Some(&head) = q.head() else { continue };
+                if best.is_none_or(|(_, b)| head > b) {
+                    others = others.max(best.map(|(_, b)| b));
+                    best = Some((i, head));
+                } else {
+                    others = others.max(Some(head));
+                }
+            }
+            run = best.map(|(i, _)| (i, others));
+            best.map(|(i, _)| i)
+        });
+        let (step, list) = match (first, follows.heap.peek()) {
+            (Some(i), Some(follow)) if *follow > lists[i].steps[lists[i].next] => (follows.heap.pop(), None),
+            (Some(i), _) => {
+                let q = &mut lists[i];
+                q.next += 1;
+                (Some(q.steps[q.next - 1]), Some(i))
             }
             // Once none of them fits, the steps waiting in the heap are passed by too.
-            (None, _) if !rising || spent + follows.extra_us <= budget_us => (follows.heap.pop(), true),
-            (None, _) => (None, true),
+            (None, _) if !rising || spent + follows.extra_us <= budget_us => (follows.heap.pop(), None),
+            (None, _) => (None, None),
         };
         let Some(step) = step else { break };
         if spent + cheapest_us > budget_us {
             break;
         }
+        let followed = list.is_none();
         debug_assert!(!(followed && step.bound), "a settled creature's steps are exact");
         let creature = step.creature as usize;
         // A step from a level the creature did not reach, or a bound since settled.
         if levels[creature] != step.from || (step.bound && settled_now[creature]) {
             continue;
         }
-        if step.bound {
+        if let Some(i) = list.filter(|_| step.bound) {
             // Worth settling only with room for the search and a step after it.
             if searches_fit && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
-                let now = ahead.take(next - 1, &listed, candidates, &settled_now, hull, room_us, &settle);
+                let at = lists[i].next - 1;
+                let now = lists[i].settle(at, candidates, &settled_now, hull, room_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
                 settled.push((creature, now.kept));
@@ -468,16 +506,189 @@ struct Hull {
 }
 
 impl Hull {
-    /// Every step up the hulls of `candidates` (the first of them the `first` creature) in the
-    /// order they are taken: a creature's steps in turn, then sorted ([`Step::sort`]). A chunk
-    /// of the creatures can be listed apart and the chunks merged ([`Step::merge`]).
-    fn list(&self, candidates: &[Candidate], first: u32, serial_bits: u32) -> Vec<Step> {
-        let mut listed = Vec::with_capacity(2 * candidates.len());
+    /// Every step up the hulls of `candidates` (the first of them the `first` creature), a
+    /// creature's steps in turn, the cheap ones sorted ([`Listing`]). A chunk of the creatures
+    /// can be listed apart and the chunks merged ([`Listing::merge`]).
+    fn list(&self, candidates: &[Candidate], first: u32, serial_bits: u32, dear_us: f32) -> Listing {
+        let mut listed = Listing {
+            dear_us,
+            creatures: candidates.len(),
+            cheap: Vec::with_capacity(2 * candidates.len()),
+            dear: Vec::new(),
+        };
         for (i, c) in (first..).zip(candidates) {
             c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
         }
-        Step::sort(&mut listed, serial_bits);
+        Step::sort(&mut listed.cheap, serial_bits);
         listed
+    }
+
+    /// The room in the budget a step needs to change anything: a bound's search beside it.
+    fn need_us(&self, step: &Step) -> f32 {
+        if step.bound {
+            self.settle_us + step.extra_us
+        } else {
+            step.extra_us
+        }
+    }
+}
+
+/// The steps listed, apart by the room each needs. The cheap ones are sorted into the order
+/// they are taken. The dear ones, each needing more than `dear_us` (so that only a few of them
+/// can ever fit), wait unsorted in a list for each room: the queue puts them in order only
+/// as far as it reaches, and passes by the rest of such a list once the budget has no room for
+/// its steps (a crowd's bounds to rigid, most of them never reached).
+struct Listing {
+    dear_us: f32,
+    /// How many creatures list their steps here.
+    creatures: usize,
+    cheap: Vec<Step>,
+    /// By whether they are bounds and the bits of what they add; a chunk's apart.
+    dear: Vec<((bool, u32), Vec<Step>)>,
+}
+
+impl Listing {
+    fn push(&mut self, step: Step, hull: &Hull) {
+        if hull.need_us(&step) <= self.dear_us {
+            return self.cheap.push(step);
+        }
+        let room = (step.bound, step.extra_us.to_bits());
+        match self.dear.iter_mut().find(|(r, _)| *r == room) {
+            Some((_, steps)) => steps.push(step),
+            None => {
+                // Room for a step of each creature: a creature lists one in a room at most, but
+                // in a crowd where two of its levels cost alike.
+                let mut steps = Vec::with_capacity(self.creatures);
+                steps.push(step);
+                self.dear.push((room, steps));
+            }
+        }
+    }
+
+    /// Chunks listed apart, as one: the cheap steps merged ([`Step::merge`]), each chunk's
+    /// dear ones kept apart (the queue merges them as it goes).
+    fn merge(chunks: Vec<Listing>, serial_bits: u32) -> Listing {
+        let (dear_us, creatures) = (
+            chunks.first().map_or(f32::INFINITY, |c| c.dear_us),
+            chunks.iter().map(|c| c.creatures).sum(),
+        );
+        let mut cheap = Vec::with_capacity(chunks.len());
+        let mut dear = Vec::new();
+        for chunk in chunks {
+            cheap.push(chunk.cheap);
+            dear.extend(chunk.dear);
+        }
+        Listing {
+            dear_us,
+            creatures,
+            cheap: Step::merge(cheap, serial_bits),
+            dear,
+        }
+    }
+}
+
+/// One list of the queue: its steps in the order they are taken as far as `sorted` (each
+/// beyond below every one before), the next to take, the room its steps need, and its bounds
+/// further on settled ahead.
+struct Queued<S> {
+    steps: Vec<Step>,
+    sorted: usize,
+    next: usize,
+    need: Need,
+    ahead: SettledAhead<S>,
+}
+
+/// The room in the budget a list's steps need, and its exact ones (infinite for a bound,
+/// which needs its search first).
+enum Need {
+    /// The least any step from each on needs (the cheap steps).
+    From(Vec<(f32, f32)>),
+    /// What every one of its steps needs (the dear steps of one room).
+    Each(f32, f32),
+}
+
+/// The fewest steps a dear list is put in order at a time.
+const DEAR_SORTED_AT_ONCE: usize = 256;
+
+impl<S: Send> Queued<S> {
+    /// The cheap steps, sorted.
+    fn cheap(steps: Vec<Step>, hull: &Hull, threads: usize) -> Self {
+        // Once the budget has less than the least room any step from here on needs, the
+        // rest of the list can change nothing and is passed by.
+        let mut need_from = vec![(f32::INFINITY, f32::INFINITY); steps.len() + 1];
+        for (i, step) in steps.iter().enumerate().rev() {
+            let (any, exact) = need_from[i + 1];
+            let need = hull.need_us(step);
+            need_from[i] = (any.min(need), if step.bound { exact } else { exact.min(need) });
+        }
+        Self {
+            sorted: steps.len(),
+            steps,
+            next: 0,
+            need: Need::From(need_from),
+            ahead: SettledAhead::new(threads),
+        }
+    }
+
+    /// The dear steps that need one room, unsorted.
+    fn dear(steps: Vec<Step>, hull: &Hull, threads: usize) -> Self {
+        let need = steps.first().map_or(f32::INFINITY, |s| hull.need_us(s));
+        let bound = steps.first().is_some_and(|s| s.bound);
+        Self {
+            steps,
+            sorted: 0,
+            next: 0,
+            need: Need::Each(need, if bound { f32::INFINITY } else { need }),
+            ahead: SettledAhead::new(threads),
+        }
+    }
+
+    /// The room its next step needs, and an exact one.
+    fn needs(&self) -> (f32, f32) {
+        match &self.need {
+            Need::From(need_from) => need_from[self.next],
+            &Need::Each(any, exact) => (any, exact),
+        }
+    }
+
+    /// Puts its steps in order as far as `end` at least: the greatest of the rest picked out
+    /// and sorted, at least as many as are sorted already, so that a list the queue runs
+    /// through is sorted in a few passes.
+    fn sort_to(&mut self, end: usize) {
+        if end <= self.sorted {
+            return;
+        }
+        let end = end.max(2 * self.sorted).max(DEAR_SORTED_AT_ONCE).min(self.steps.len());
+        let (rest, count) = (&mut self.steps[self.sorted..], end - self.sorted);
+        if count < rest.len() {
+            rest.select_nth_unstable_by(count - 1, |a, b| b.cmp(a));
+        }
+        rest[..count].sort_unstable_by(|a, b| b.cmp(a));
+        self.sorted = end;
+    }
+
+    /// Its next step.
+    fn head(&mut self) -> Option<&Step> {
+        self.sort_to(self.next + 1);
+        self.steps.get(self.next)
+    }
+
+    /// The bound it listed at `at`, settled, with the next bounds ahead of it across the cores
+    /// ([`SettledAhead::take`]).
+    #[allow(clippy::too_many_arguments)]
+    fn settle(
+        &mut self,
+        at: usize,
+        candidates: &[Candidate],
+        settled_now: &[bool],
+        hull: &Hull,
+        room_us: f32,
+        settle: &(impl Fn(usize) -> (f32, S) + Sync),
+    ) -> Settled<S> {
+        self.sort_to(at + 1 + self.ahead.batch);
+        let sorted = &self.steps[..self.sorted];
+        self.ahead
+            .take(at, sorted, candidates, settled_now, hull, room_us, settle)
     }
 }
 
@@ -562,6 +773,10 @@ impl<S: Send> SettledAhead<S> {
     }
 }
 
+/// A step needing over this share of the room the floors leave is dear ([`Listing`]): no more
+/// than this many such steps fit.
+const DEAR_STEPS: f32 = 1024.0;
+
 /// The most bounds settled ahead at once.
 const MAX_SETTLED_AHEAD: usize = 4096;
 
@@ -624,6 +839,17 @@ impl Floors {
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
         self.rising &= c.rising;
         self.most_serial = self.most_serial.max(serial);
+    }
+
+    /// What a step must need to be dear ([`Listing`]): over a [`DEAR_STEPS`]th of the room the
+    /// floors leave in `budget_us`. Where a level can cost less than the one below, none is
+    /// (what is spent does not only grow, so no list of steps is ever passed by).
+    fn dear_us(&self, budget_us: f32) -> f32 {
+        if self.rising {
+            (budget_us - self.cost_us) / DEAR_STEPS
+        } else {
+            f32::INFINITY
+        }
     }
 
     fn any_step_fits(&self, budget_us: f32) -> bool {
@@ -1114,7 +1340,8 @@ fn decide(
     let mut bounds = vec![Bounds::default(); rows.len()];
     let mut settled_now = vec![false; rows.len()];
     let n = chunk_len(config.scenario.creature_count(), rows.len());
-    let mut chunks = vec![Vec::new(); rows.len().div_ceil(n)];
+    let dear_us = floors.dear_us(room_us);
+    let mut chunks: Vec<Option<Listing>> = (0..rows.len().div_ceil(n)).map(|_| None).collect();
     run_chunks(
         (rows.chunks(n).zip(candidates.chunks_mut(n)))
             .zip(bounds.chunks_mut(n).zip(settled_now.chunks_mut(n)))
@@ -1135,11 +1362,11 @@ fn decide(
                         candidate.settled = standing.is_some() || bound.settled(scene);
                         *settled = candidate.settled;
                     }
-                    *listed = hull.list(candidates, first, serial_bits);
+                    *listed = Some(hull.list(candidates, first, serial_bits, dear_us));
                 }
             }),
     );
-    let listed = Step::merge(chunks, serial_bits);
+    let listed = Listing::merge(chunks.into_iter().flatten().collect(), serial_bits);
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut candidates, floors, settled_now, listed, room_us, &hull, |i| {
         let (_, c, _, s, _) = rows[i];
@@ -1469,6 +1696,32 @@ mod tests {
                 "{budget_us} us: {}",
                 charged.predicted_us
             );
+        }
+    }
+
+    #[test]
+    fn dear_steps_put_in_order_only_as_far_as_the_queue_reaches_are_taken_as_if_all_were_sorted() {
+        let (crowd, exact) = mixed_crowd(3000);
+        // Bounds to settle, and exact steps.
+        for (crowd, settle_us) in [(&crowd, 0.0), (&crowd, 3.0), (&settled_first(&crowd, &exact), 0.0)] {
+            let hull = Hull {
+                hysteresis: 0.2,
+                least_per_us: 0.0,
+                settle_us,
+            };
+            let mut floors = Floors::with_capacity(crowd.len());
+            crowd.iter().for_each(|c| floors.add(c.into(), c.serial));
+            // Room for a few steps to rigid (and with the least, for a few hybrid ones), to many.
+            for room_us in [50.0, 500.0, 5000.0, 50_000.0] {
+                let budget_us = floors.cost_us + room_us;
+                let listing = hull.list(crowd, 0, 12, floors.dear_us(budget_us));
+                assert!(listing.dear.iter().any(|(_, steps)| steps.len() > 300));
+                let lazy = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
+                let sorted = list_and_allocate(&mut crowd.clone(), budget_us, &hull, Some(f32::INFINITY), |i| {
+                    (exact[i], i)
+                });
+                assert_eq!(lazy, sorted, "{budget_us} us, searches of {settle_us} us");
+            }
         }
     }
 
