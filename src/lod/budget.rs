@@ -367,8 +367,6 @@ fn allocate_listed<S: Send>(
             let (any, exact) = q.needs();
             !rising || spent + if searches_fit { any } else { exact } <= budget_us
         };
-        // (Steps are compared where they lie, not copied: a copy read back soon after it is
-        // written stalls the loop.)
         let running_on = run.and_then(|(i, others)| {
             let q = &mut lists[i];
             (live(q) && q.head().is_some_and(|h| others.is_none_or(|o| *h > o))).then_some(i)
@@ -417,8 +415,14 @@ fn allocate_listed<S: Send>(
             if searches_fit && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
-                let at = lists[i].next - 1;
-                let now = lists[i].settle(at, candidates, &settled_now, hull, room_us, &settle);
+                // Settled with the next bounds of its list, put in order that far.
+                let q = &mut lists[i];
+                let at = q.next - 1;
+                q.sort_to(at + 1 + q.ahead.batch);
+                let sorted = &q.steps[..q.sorted];
+                let now = q
+                    .ahead
+                    .take(at, sorted, candidates, &settled_now, hull, room_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
                 settled.push((creature, now.kept));
@@ -671,24 +675,6 @@ impl<S: Send> Queued<S> {
     fn head(&mut self) -> Option<&Step> {
         self.sort_to(self.next + 1);
         self.steps.get(self.next)
-    }
-
-    /// The bound it listed at `at`, settled, with the next bounds ahead of it across the cores
-    /// ([`SettledAhead::take`]).
-    #[allow(clippy::too_many_arguments)]
-    fn settle(
-        &mut self,
-        at: usize,
-        candidates: &[Candidate],
-        settled_now: &[bool],
-        hull: &Hull,
-        room_us: f32,
-        settle: &(impl Fn(usize) -> (f32, S) + Sync),
-    ) -> Settled<S> {
-        self.sort_to(at + 1 + self.ahead.batch);
-        let sorted = &self.steps[..self.sorted];
-        self.ahead
-            .take(at, sorted, candidates, settled_now, hull, room_us, settle)
     }
 }
 
