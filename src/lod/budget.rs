@@ -1700,7 +1700,12 @@ mod tests {
             // Room for a few steps to rigid (and with the least, for a few hybrid ones), to many.
             for room_us in [50.0, 500.0, 5000.0, 50_000.0] {
                 let budget_us = floors.cost_us + room_us;
-                let listing = hull.list(crowd, 0, 12, floors.dear_us(budget_us));
+                let listing = hull.list(
+                    crowd,
+                    0,
+                    Step::serial_bits(floors.most_serial),
+                    floors.dear_us(budget_us),
+                );
                 assert!(listing.dear.iter().any(|(_, steps)| steps.len() > 300));
                 let lazy = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
                 let sorted = list_and_allocate(&mut crowd.clone(), budget_us, &hull, Some(f32::INFINITY), |i| {
