@@ -25,7 +25,9 @@ use bevy::prelude::*;
 use serde::Serialize;
 use std::cell::Cell;
 
-use super::select::{Area, DecisionInputs, LevelChoice, SimCamera, areas_now, select_levels, start_at_selected_levels};
+use super::select::{
+    Area, DecisionInputs, LevelChoice, SimCamera, ViewReach, areas_now, select_levels, start_at_selected_levels,
+};
 use super::{LevelPolicy, Lod};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::contract::GaitPose;
@@ -33,7 +35,7 @@ use crate::contract::SimClock;
 use crate::contract::{GaitPhase, PlanarState};
 use crate::contract::{SimStage, SimStart, StartStage};
 use crate::contract::{chunk_len, run_chunks, threads_for};
-use crate::kind::{Creature, KindParams, KindTable, starting_gait};
+use crate::kind::{Creature, KindTable, starting_gait};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
 
@@ -1000,6 +1002,8 @@ struct Scene<'a> {
     court: &'a Court,
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
+    /// Each kind's reach against the view, by kind.
+    view_reach: Vec<ViewReach>,
     /// The fastest kind's top speed, for the earliest possible contacts.
     top_speed: f32,
     /// How far away another creature can still matter.
@@ -1115,9 +1119,10 @@ impl Scene<'_> {
 
     /// How much the viewer sees of a creature: 0 out of view, 1 at the camera, halving at
     /// `view_half_distance_m`.
-    fn view(&self, kind: &KindParams, s: &PlanarState) -> f32 {
-        if self.camera.sees_creature(kind, s, 0.0) {
-            1.0 / (1.0 + self.camera.ground_distance(s.position) / self.rules.view_half_distance_m)
+    fn view(&self, reach: &ViewReach, s: &PlanarState) -> f32 {
+        let distance = self.camera.ground_distance(s.position);
+        if self.camera.sees_within(reach, s.position, distance) {
+            1.0 / (1.0 + distance / self.rules.view_half_distance_m)
         } else {
             0.0
         }
@@ -1126,9 +1131,9 @@ impl Scene<'_> {
     /// What one creature's levels are worth before its search for contacts with other
     /// creatures: exact for the point mass and the hybrid, the most it can be for the rigid
     /// level, unless the puck, an area or a wall already outweighs any other creature.
-    fn bounds(&self, entity: Entity, s: &PlanarState, kind: &KindParams) -> Bounds {
+    fn bounds(&self, entity: Entity, s: &PlanarState, kind: usize, radius_m: f32) -> Bounds {
         let r = self.rules;
-        let view = self.view(kind, s);
+        let view = self.view(&self.view_reach[kind], s);
         let hybrid = r.view_hybrid_weight * view;
         let followed = if self.camera.following == Some(entity) {
             r.player_rigid_weight
@@ -1138,7 +1143,7 @@ impl Scene<'_> {
         Bounds {
             hybrid,
             seen: hybrid + r.view_rigid_weight * view + followed,
-            near: self.near(s, kind.radius_m),
+            near: self.near(s, radius_m),
         }
     }
 }
@@ -1340,7 +1345,7 @@ fn decide(
                         .zip(candidates.iter_mut())
                         .zip(bounds.iter_mut().zip(settled_now));
                     for ((&(entity, c, _, s, choice), candidate), (bound, settled)) in creatures {
-                        *bound = scene.bounds(entity, s, &kinds[c.kind]);
+                        *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
                         // A search within `contact_recheck_s` stands; without one, any
                         // contact with another creature could be now.
                         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
@@ -1383,6 +1388,7 @@ fn scene<'a>(
         court,
         grid,
         camera,
+        view_reach: kinds.0.iter().map(|k| camera.view_reach(k, 0.0)).collect(),
         top_speed,
         // Beyond three horizons at both creatures' top speeds, a contact is worth under 5 %.
         reach_m: 2.0 * biggest + rules.contact_margin_m + 2.0 * top_speed * 3.0 * rules.contact_horizon_s,
@@ -1817,6 +1823,7 @@ mod tests {
             court,
             grid,
             camera,
+            view_reach: Vec::new(),
             top_speed: 3.0,
             reach_m,
             outweigh_creature_s: (outweigh_times_s(b, b.puck_weight), outweigh_times_s(b, b.wall_weight)),

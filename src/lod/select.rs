@@ -126,17 +126,47 @@ impl SimCamera {
     /// within a hop, the longest a switch waits for its flight window: the creature covers
     /// up to a hop at top speed, and the view sweeps `distance x turn` meanwhile.
     pub fn sees_creature(&self, kind: &KindParams, s: &PlanarState, margin_m: f32) -> bool {
-        let (height, radius) = kind.view_sphere_m;
+        let reach = self.view_reach(kind, margin_m);
+        self.sees_within(&reach, s.position, self.ground_distance(s.position))
+    }
+
+    /// What [`SimCamera::sees_creature`] needs of a kind and margin: the same for each of its
+    /// creatures, so worked out once for a crowd.
+    pub fn view_reach(&self, kind: &KindParams, margin_m: f32) -> ViewReach {
+        let (height_m, radius) = kind.view_sphere_m;
         let hop_s = 1.0 / kind.cycles_per_s;
         let sweep = (self.turn_rate_rad_per_s * hop_s).min(std::f32::consts::FRAC_PI_2);
-        let reach = kind.top_speed_m_per_s * hop_s + self.ground_distance(s.position) * sweep.sin();
-        self.sees(s.position.extend(height).xzy(), radius + margin_m + reach)
+        ViewReach {
+            height_m,
+            radius_m: radius + margin_m,
+            hop_m: kind.top_speed_m_per_s * hop_s,
+            sweep: sweep.sin(),
+        }
+    }
+
+    /// [`SimCamera::sees_creature`] for a creature at `position`, `ground_distance_m` from the eye.
+    pub fn sees_within(&self, reach: &ViewReach, position: Vec2, ground_distance_m: f32) -> bool {
+        let moved = reach.hop_m + ground_distance_m * reach.sweep;
+        self.sees(position.extend(reach.height_m).xzy(), reach.radius_m + moved)
     }
 
     /// Distance on the ground from the eye.
     pub fn ground_distance(&self, q: Vec2) -> f32 {
         self.eye.xz().distance(q)
     }
+}
+
+/// A kind's sphere against the frustum, and how far it and the view can move within a hop:
+/// [`SimCamera::view_reach`].
+#[derive(Clone, Copy, Debug)]
+pub struct ViewReach {
+    height_m: f32,
+    /// The sphere's radius and the margin.
+    radius_m: f32,
+    /// A hop at top speed.
+    hop_m: f32,
+    /// How far the view sweeps within a hop, per metre from the eye.
+    sweep: f32,
 }
 
 /// Present when a window's camera writes [`SimCamera`] (the game): the camera rule then
