@@ -360,7 +360,34 @@ fn allocate_listed<S: Send>(
     let mut run: Option<(usize, Option<Step>)> = None;
     let mut follows = Follows::default();
     let (mut taken, mut settled) = (Vec::new(), Vec::new());
-    loop {
+    'queue: loop {
+        // A run on a list: its exact steps in order taken in turn, as the loop below would take
+        // them one by one, while each stays ahead of the others' heads and of the steps that
+        // follow settled creatures (neither changes meanwhile).
+        if let Some((i, others)) = run {
+            let q = &mut lists[i];
+            let follow = follows.heap.peek().copied();
+            while q.next < q.sorted {
+                let step = q.steps[q.next];
+                let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
+                let (any, exact) = q.needs();
+                let live = !rising || spent + if searches_fit { any } else { exact } <= budget_us;
+                if !live || step.bound || others.is_some_and(|o| step <= o) || follow.is_some_and(|f| f > step) {
+                    break;
+                }
+                q.next += 1;
+                if spent + cheapest_us > budget_us {
+                    break 'queue;
+                }
+                let creature = step.creature as usize;
+                if levels[creature] == step.from && spent + step.extra_us <= budget_us {
+                    levels[creature] = step.to;
+                    spent += step.extra_us;
+                    running_us += step.running_us;
+                    taken.push(step);
+                }
+            }
+        }
         let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
         // Whether a list's next step could fit, or any after it (once the budget has less, or
         // no search fits beside the frame as it will run, which only grows, the rest of the
