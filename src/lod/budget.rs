@@ -100,10 +100,11 @@ impl Candidate<'_> {
         let (mut best, mut best_ratio) = (None, f32::NEG_INFINITY);
         // After its search, only a step that gains can follow a bound.
         let mut after_search_us = f32::INFINITY;
-        for &to in self.levels {
+        // Only a level above can be a step up.
+        for &to in self.levels.iter().filter(|&&to| to > at) {
             let (to_cost, to_value) = (p.cost_us[to as usize], p.value[to as usize]);
-            let gains = to > at && to_value > value;
-            if gains || (to > at && to == Lod::Rigid) {
+            let gains = to_value > value;
+            if gains || to == Lod::Rigid {
                 after_search_us = after_search_us.min(to_cost - cost);
             }
             if !gains {
