@@ -1296,13 +1296,13 @@ fn decide(
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
         if dwelling { lod } else { kinds[c.kind].levels[0] }
     };
-    let candidate = |c: &Creature, lod: Lod, choice: &LevelChoice| {
+    let candidate = |c: &Creature, lod: Lod, choice: &LevelChoice, floor: Lod| {
         let kind = &kinds[c.kind];
         Candidate {
             serial: c.serial,
             current: lod,
             last: choice.wanted,
-            floor: floor(c, lod, choice),
+            floor,
             levels: &kind.levels,
             costs: costs[c.kind],
             benefit: [0.0; 3],
@@ -1329,9 +1329,13 @@ fn decide(
             })
         })
         .collect();
+    // The creatures gathered in the same pass.
     let mut floors = Floors::with_capacity(creatures.iter().len());
-    for (_, c, &lod, _, choice) in creatures {
+    let mut rows = Vec::with_capacity(floors.levels.capacity());
+    for row in creatures {
+        let (_, c, &lod, _, choice) = row;
         floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize], c.serial);
+        rows.push(row);
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
@@ -1342,10 +1346,8 @@ fn decide(
     if !floors.any_step_fits(room_us) {
         return floors.allocation(budget_us, config.costs.overhead_us(0));
     }
-    let rows: Vec<_> = creatures.iter().collect();
-    let mut candidates: Vec<Candidate> = rows
-        .iter()
-        .map(|&(_, c, &lod, _, choice)| candidate(c, lod, choice))
+    let mut candidates: Vec<Candidate> = (rows.iter().zip(&floors.levels))
+        .map(|(&(_, c, &lod, _, choice), &floor)| candidate(c, lod, choice, floor))
         .collect();
     let rules = &config.rules.budget;
     let hull = Hull {
