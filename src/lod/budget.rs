@@ -353,14 +353,16 @@ fn allocate_listed<S: Send>(
             listed
                 .dear
                 .into_iter()
-                .map(|(_, steps)| Queued::dear(steps, hull, threads)),
+                .map(|(_, dear)| Queued::dear(dear, hull, threads)),
         );
     }
     // The list last taken from, and the best next step of the others then: it is taken from
     // while its next step is above that.
     let mut run: Option<(usize, Option<Step>)> = None;
     let mut follows = Follows::default();
-    let (mut taken, mut settled) = (Vec::new(), Vec::new());
+    // Room for every cheap step to be taken: most are, in a crowd.
+    let mut taken = Vec::with_capacity(lists.first().map_or(0, |q| q.steps.len()));
+    let mut settled = Vec::new();
     'queue: loop {
         // A run on a list: its exact steps in order taken in turn, as the loop below would take
         // them one by one, while each stays ahead of the others' heads and of the steps that
@@ -418,6 +420,9 @@ fn allocate_listed<S: Send>(
             run = best.map(|(i, _)| (i, others));
             best.map(|(i, _)| i)
         });
+        if let Some(q) = first.map(|i| &mut lists[i]) {
+            q.sort_to(q.next + 1);
+        }
         let (step, list) = match (first, follows.heap.peek()) {
             (Some(i), Some(follow)) if *follow > lists[i].steps[lists[i].next] => (follows.heap.pop(), None),
             (Some(i), _) => {
@@ -578,7 +583,14 @@ struct Listing {
     creatures: usize,
     cheap: Vec<Step>,
     /// By whether they are bounds and the bits of what they add; a chunk's apart.
-    dear: Vec<((bool, u32), Vec<Step>)>,
+    dear: Vec<((bool, u32), DearSteps)>,
+}
+
+/// The dear steps that need one room, as listed, and the best of them: the head of their list
+/// in the queue before it is put in order (most dear lists are never taken from).
+struct DearSteps {
+    steps: Vec<Step>,
+    best: Step,
 }
 
 impl Listing {
@@ -588,13 +600,16 @@ impl Listing {
         }
         let room = (step.bound, step.extra_us.to_bits());
         match self.dear.iter_mut().find(|(r, _)| *r == room) {
-            Some((_, steps)) => steps.push(step),
+            Some((_, dear)) => {
+                dear.best = dear.best.max(step);
+                dear.steps.push(step);
+            }
             None => {
                 // Room for a step of each creature: a creature lists one in a room at most, but
                 // in a crowd where two of its levels cost alike.
                 let mut steps = Vec::with_capacity(self.creatures);
                 steps.push(step);
-                self.dear.push((room, steps));
+                self.dear.push((room, DearSteps { steps, best: step }));
             }
         }
     }
@@ -622,11 +637,12 @@ impl Listing {
 }
 
 /// One list of the queue: its steps in the order they are taken as far as `sorted` (each
-/// beyond below every one before), the next to take, the room its steps need, and its bounds
-/// further on settled ahead.
+/// beyond below every one before), the best of them while none is (a dear list's), the next
+/// to take, the room its steps need, and its bounds further on settled ahead.
 struct Queued<S> {
     steps: Vec<Step>,
     sorted: usize,
+    best: Option<Step>,
     next: usize,
     need: Need,
     ahead: SettledAhead<S>,
@@ -658,6 +674,7 @@ impl<S: Send> Queued<S> {
         Self {
             sorted: steps.len(),
             steps,
+            best: None,
             next: 0,
             need: Need::From(need_from),
             ahead: SettledAhead::new(threads),
@@ -665,12 +682,12 @@ impl<S: Send> Queued<S> {
     }
 
     /// The dear steps that need one room, unsorted.
-    fn dear(steps: Vec<Step>, hull: &Hull, threads: usize) -> Self {
-        let need = steps.first().map_or(f32::INFINITY, |s| hull.need_us(s));
-        let bound = steps.first().is_some_and(|s| s.bound);
+    fn dear(dear: DearSteps, hull: &Hull, threads: usize) -> Self {
+        let (need, bound) = (hull.need_us(&dear.best), dear.best.bound);
         Self {
-            steps,
+            steps: dear.steps,
             sorted: 0,
+            best: Some(dear.best),
             next: 0,
             need: Need::Each(need, if bound { f32::INFINITY } else { need }),
             ahead: SettledAhead::new(threads),
@@ -701,8 +718,11 @@ impl<S: Send> Queued<S> {
         self.sorted = end;
     }
 
-    /// Its next step.
+    /// Its next step: before any is put in order, the best.
     fn head(&mut self) -> Option<&Step> {
+        if self.sorted == 0 && self.best.is_some() {
+            return self.best.as_ref();
+        }
         self.sort_to(self.next + 1);
         self.steps.get(self.next)
     }
@@ -1742,7 +1762,7 @@ mod tests {
                     Step::serial_bits(floors.most_serial),
                     floors.dear_us(budget_us),
                 );
-                assert!(listing.dear.iter().any(|(_, steps)| steps.len() > 300));
+                assert!(listing.dear.iter().any(|(_, dear)| dear.steps.len() > 300));
                 let lazy = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
                 let sorted = list_and_allocate(&mut crowd.clone(), budget_us, &hull, Some(f32::INFINITY), |i| {
                     (exact[i], i)
