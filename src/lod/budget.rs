@@ -549,17 +549,18 @@ impl Hull {
     /// creature's steps in turn, the cheap ones sorted ([`Listing`]). A chunk of the creatures
     /// can be listed apart and the chunks merged ([`Listing::merge`]).
     fn list(&self, candidates: &[Candidate], first: u32, serial_bits: u32, dear_us: f32) -> Listing {
-        let mut listed = Listing {
-            dear_us,
-            creatures: candidates.len(),
-            cheap: Vec::with_capacity(2 * candidates.len()),
-            dear: Vec::new(),
-        };
-        for (i, c) in (first..).zip(candidates) {
-            c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
-        }
+        let mut listed = Listing::new(dear_us, candidates.len());
+        self.list_into(candidates, first, &mut listed);
         Step::sort(&mut listed.cheap, serial_bits);
         listed
+    }
+
+    /// [`Hull::list`] into `listed`, the cheap steps left unsorted: a block of the creatures
+    /// listed among others.
+    fn list_into(&self, candidates: &[Candidate], first: u32, listed: &mut Listing) {
+        for (i, c) in (first..).zip(candidates) {
+            c.list_hull(i, self, &c.priced(self.hysteresis), listed);
+        }
     }
 
     /// The room in the budget a step needs to change anything: a bound's search beside it.
@@ -594,6 +595,16 @@ struct DearSteps {
 }
 
 impl Listing {
+    /// Nothing listed yet, with room for the steps of `creatures`.
+    fn new(dear_us: f32, creatures: usize) -> Self {
+        Self {
+            dear_us,
+            creatures,
+            cheap: Vec::with_capacity(2 * creatures),
+            dear: Vec::new(),
+        }
+    }
+
     fn push(&mut self, step: Step, hull: &Hull) {
         if hull.need_us(&step) <= self.dear_us {
             return self.cheap.push(step);
@@ -1302,6 +1313,9 @@ impl Allocation<f32> {
     }
 }
 
+/// Creatures dealt to a core at a time by the budget's choice.
+const DEALT_BLOCK: usize = 1024;
+
 /// The allocation for every creature now, in the query's order.
 fn decide(
     now_s: f32,
@@ -1377,36 +1391,46 @@ fn decide(
     };
     let serial_bits = Step::serial_bits(floors.most_serial);
     // Each creature's bounds and steps are its own, worked out and listed across the cores,
-    // each chunk's steps sorted while they are at hand, then merged.
+    // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
+    // the cores a block at a time in turn: what one costs here depends on where it is (in view
+    // or not), and the query keeps neighbours together, so that halves of it would not balance.
     let mut bounds = vec![Bounds::default(); rows.len()];
     let mut settled_now = vec![false; rows.len()];
-    let n = chunk_len(config.scenario.creature_count(), rows.len());
+    let threads = rows
+        .len()
+        .div_ceil(chunk_len(config.scenario.creature_count(), rows.len()));
     let dear_us = floors.dear_us(room_us);
-    let mut chunks: Vec<Option<Listing>> = (0..rows.len().div_ceil(n)).map(|_| None).collect();
-    run_chunks(
-        (rows.chunks(n).zip(candidates.chunks_mut(n)))
-            .zip(bounds.chunks_mut(n).zip(settled_now.chunks_mut(n)))
-            .zip(chunks.iter_mut().zip((0..).step_by(n)))
-            .map(|(((rows, candidates), (bounds, settled_now)), (listed, first))| {
-                let hull = &hull;
-                move || {
-                    let creatures = rows
-                        .iter()
-                        .zip(candidates.iter_mut())
-                        .zip(bounds.iter_mut().zip(settled_now));
-                    for ((&(entity, c, _, s, choice), candidate), (bound, settled)) in creatures {
-                        *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
-                        // A search within `contact_recheck_s` stands; without one, any
-                        // contact with another creature could be now.
-                        let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
-                        candidate.benefit = [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))];
-                        candidate.settled = standing.is_some() || bound.settled(scene);
-                        *settled = candidate.settled;
-                    }
-                    *listed = Some(hull.list(candidates, first, serial_bits, dear_us));
+    let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
+    let blocks = (rows.chunks(DEALT_BLOCK).zip(candidates.chunks_mut(DEALT_BLOCK)))
+        .zip(bounds.chunks_mut(DEALT_BLOCK).zip(settled_now.chunks_mut(DEALT_BLOCK)));
+    for (b, block) in blocks.enumerate() {
+        dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
+    }
+    let mut chunks: Vec<Option<Listing>> = (0..threads).map(|_| None).collect();
+    run_chunks(dealt.into_iter().zip(chunks.iter_mut()).map(|(blocks, listed)| {
+        let hull = &hull;
+        move || {
+            let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, ((rows, _), _))| rows.len()).sum());
+            for (first, ((rows, candidates), (bounds, settled_now))) in blocks {
+                let creatures = rows
+                    .iter()
+                    .zip(candidates.iter_mut())
+                    .zip(bounds.iter_mut().zip(settled_now));
+                for ((&(entity, c, _, s, choice), candidate), (bound, settled)) in creatures {
+                    *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
+                    // A search within `contact_recheck_s` stands; without one, any contact with
+                    // another creature could be now.
+                    let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
+                    candidate.benefit = [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))];
+                    candidate.settled = standing.is_some() || bound.settled(scene);
+                    *settled = candidate.settled;
                 }
-            }),
-    );
+                hull.list_into(candidates, first, &mut listing);
+            }
+            Step::sort(&mut listing.cheap, serial_bits);
+            *listed = Some(listing);
+        }
+    }));
     let listed = Listing::merge(chunks.into_iter().flatten().collect(), serial_bits);
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut candidates, floors, settled_now, listed, room_us, &hull, |i| {
