@@ -363,6 +363,15 @@ fn allocate_listed<S: Send>(
     // Room for every cheap step to be taken: most are, in a crowd.
     let mut taken = Vec::with_capacity(lists.first().map_or(0, |q| q.steps.len()));
     let mut settled = Vec::new();
+    // Whether a search fits beside the frame as it will run.
+    let searches_fit = |running_us: f32| settle_us == 0.0 || running_us + settle_us <= budget_us;
+    // Whether a list's next step could fit, or any after it (once the budget has less, or no
+    // search fits beside the frame as it will run, which only grows, the rest of the list can
+    // change nothing and is passed by).
+    let live = |q: &Queued<S>, spent: f32, running_us: f32| {
+        let (any, exact) = q.needs();
+        !rising || spent + if searches_fit(running_us) { any } else { exact } <= budget_us
+    };
     'queue: loop {
         // A run on a list: its exact steps in order taken in turn, as the loop below would take
         // them one by one, while each stays ahead of the others' heads and of the steps that
@@ -372,10 +381,11 @@ fn allocate_listed<S: Send>(
             let follow = follows.heap.peek().copied();
             while q.next < q.sorted {
                 let step = q.steps[q.next];
-                let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
-                let (any, exact) = q.needs();
-                let live = !rising || spent + if searches_fit { any } else { exact } <= budget_us;
-                if !live || step.bound || others.is_some_and(|o| step <= o) || follow.is_some_and(|f| f > step) {
+                if !live(q, spent, running_us)
+                    || step.bound
+                    || others.is_some_and(|o| step <= o)
+                    || follow.is_some_and(|f| f > step)
+                {
                     break;
                 }
                 q.next += 1;
@@ -391,14 +401,7 @@ fn allocate_listed<S: Send>(
                 }
             }
         }
-        let searches_fit = settle_us == 0.0 || running_us + settle_us <= budget_us;
-        // Whether a list's next step could fit, or any after it (once the budget has less, or
-        // no search fits beside the frame as it will run, which only grows, the rest of the
-        // list can change nothing and is passed by).
-        let live = |q: &Queued<S>| {
-            let (any, exact) = q.needs();
-            !rising || spent + if searches_fit { any } else { exact } <= budget_us
-        };
+        let live = |q: &Queued<S>| live(q, spent, running_us);
         let running_on = run.and_then(|(i, others)| {
             let q = &mut lists[i];
             (live(q) && q.head().is_some_and(|h| others.is_none_or(|o| *h > o))).then_some(i)
@@ -447,7 +450,7 @@ fn allocate_listed<S: Send>(
         }
         if let Some(i) = list.filter(|_| step.bound) {
             // Worth settling only with room for the search and a step after it.
-            if searches_fit && spent + settle_us + step.extra_us <= budget_us {
+            if searches_fit(running_us) && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
                 // Settled with the next bounds of its list, put in order that far.
