@@ -484,10 +484,8 @@ fn allocate_listed<S: Send>(
     let searched_us = settled.len() as f32 * settle_us;
     let frame = |levels: &[Lod]| -> f32 {
         searched_us
-            + candidates
-                .iter()
-                .zip(levels)
-                .map(|(c, &l)| c.frame_cost_us(l))
+            + (floors.frame_at_us.iter().zip(levels))
+                .map(|(at, &l)| at[l as usize])
                 .sum::<f32>()
     };
     let mut predicted_us = frame(&levels);
@@ -835,6 +833,9 @@ const MAX_SETTLED_AHEAD: usize = 4096;
 /// [`allocate`] gives every creature its floor, so they are the choice).
 struct Floors {
     levels: Vec<Lod>,
+    /// What each creature adds to the frame as it will run at each level, by `Lod as usize`:
+    /// the knapsack's closing sums read these, not the creatures' candidates.
+    frame_at_us: Vec<[f32; 3]>,
     /// What the floors cost, us.
     cost_us: f32,
     /// The frame as it will run at the floors (creatures going down still cost their level), us.
@@ -854,6 +855,7 @@ struct AtFloor {
     floor: Lod,
     cost_us: f32,
     frame_us: f32,
+    frame_at_us: [f32; 3],
     cheapest_step_us: f32,
     rising: bool,
 }
@@ -864,6 +866,7 @@ impl From<&Candidate<'_>> for AtFloor {
             floor: c.floor,
             cost_us: c.cost_us(c.floor),
             frame_us: c.frame_cost_us(c.floor),
+            frame_at_us: Lod::ALL.map(|l| c.frame_cost_us(l)),
             cheapest_step_us: c.cheapest_step_above_floor_us(&c.priced(0.0)),
             rising: c.costs.rise_with_level(),
         }
@@ -874,6 +877,7 @@ impl Floors {
     fn with_capacity(creatures: usize) -> Self {
         Self {
             levels: Vec::with_capacity(creatures),
+            frame_at_us: Vec::with_capacity(creatures),
             cost_us: 0.0,
             frame_us: 0.0,
             cheapest_step_us: f32::INFINITY,
@@ -884,6 +888,7 @@ impl Floors {
 
     fn add(&mut self, c: AtFloor, serial: u32) {
         self.levels.push(c.floor);
+        self.frame_at_us.push(c.frame_at_us);
         self.cost_us += c.cost_us;
         self.frame_us += c.frame_us;
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
