@@ -854,7 +854,6 @@ struct Floors {
 struct AtFloor {
     floor: Lod,
     cost_us: f32,
-    frame_us: f32,
     frame_at_us: [f32; 3],
     cheapest_step_us: f32,
     rising: bool,
@@ -865,7 +864,6 @@ impl From<&Candidate<'_>> for AtFloor {
         Self {
             floor: c.floor,
             cost_us: c.cost_us(c.floor),
-            frame_us: c.frame_cost_us(c.floor),
             frame_at_us: Lod::ALL.map(|l| c.frame_cost_us(l)),
             cheapest_step_us: c.cheapest_step_above_floor_us(&c.priced(0.0)),
             rising: c.costs.rise_with_level(),
@@ -890,7 +888,7 @@ impl Floors {
         self.levels.push(c.floor);
         self.frame_at_us.push(c.frame_at_us);
         self.cost_us += c.cost_us;
-        self.frame_us += c.frame_us;
+        self.frame_us += c.frame_at_us[c.floor as usize];
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
         self.rising &= c.rising;
         self.most_serial = self.most_serial.max(serial);
