@@ -59,8 +59,8 @@ const _: () = assert!(
 /// Cells per block along a row: the index keeps where each block's entries start, not each
 /// cell's, so a rebuild clears and sums a thirty-second of the cells (some 27 cells a creature at
 /// the shipped density: the cells, not the creatures, were most of a rebuild and of the
-/// memory). A block's row holds about one creature there, so a query's row scans about one
-/// entry more than it keeps.
+/// memory). A block holds about one creature there (72 m²), so each row of a query scans about
+/// one entry more than it keeps.
 const BLOCK_CELLS: u32 = 32;
 
 /// A uniform grid over the court, rebuilt by counting sort at every steering decision.
