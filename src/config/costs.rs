@@ -25,6 +25,12 @@ pub struct CostModel {
     /// taken from the budget with the fixed cost. A file without it predicts 0.
     #[serde(default)]
     pub decision_us_per_creature: f32,
+    /// What the choice costs per creature where not one step up fits beside the creatures'
+    /// floors, in microseconds: a pass over the crowd that gives each its floor, no benefit
+    /// worked out. Charged then in place of `decision_us_per_creature`. A file without it
+    /// predicts 0.
+    #[serde(default)]
+    pub floors_only_us_per_creature: f32,
     /// What the choice's search for one creature's soonest contact with another costs, in
     /// microseconds: taken from the budget for each creature searched (only those that could
     /// still buy a level are). A file without it predicts 0.
@@ -61,6 +67,10 @@ pub struct CrowdShares {
     /// Of the budget policy's choice per creature (a file without it: 1).
     #[serde(default = "CrowdShares::whole")]
     pub choice: f32,
+    /// Of the choice's pass where only the floors fit (a file without it: 1). The pass runs
+    /// on one thread, and a large crowd's creatures are further apart in memory: above 1.
+    #[serde(default = "CrowdShares::whole")]
+    pub floors_only: f32,
 }
 
 impl CrowdShares {
@@ -135,8 +145,19 @@ impl CostModel {
     /// Predicted microseconds of a frame of `creatures` before any creature's level: the
     /// fixed cost and the budget policy's choice (in a crowd, at its share).
     pub fn overhead_us(&self, creatures: usize) -> f32 {
-        let share = self.shares_in_crowd(creatures as u32).map_or(1.0, |s| s.choice);
-        self.fixed_us_per_frame + self.decision_us_per_creature * share * creatures as f32
+        self.overhead_at_us(creatures, self.decision_us_per_creature, |s| s.choice)
+    }
+
+    /// [`CostModel::overhead_us`] where not one step up fits beside the floors: the choice is
+    /// then its pass over the crowd.
+    pub fn floors_only_overhead_us(&self, creatures: usize) -> f32 {
+        self.overhead_at_us(creatures, self.floors_only_us_per_creature, |s| s.floors_only)
+    }
+
+    /// The fixed cost, and the choice at `per_creature_us` and its `share` in a crowd.
+    fn overhead_at_us(&self, creatures: usize, per_creature_us: f32, share: fn(&CrowdShares) -> f32) -> f32 {
+        let share = self.shares_in_crowd(creatures as u32).map_or(1.0, |s| share(&s));
+        self.fixed_us_per_frame + per_creature_us * share * creatures as f32
     }
 
     /// The costs of the kind named `kind` in a world of `creatures`: in a crowd, the cheap
@@ -170,6 +191,7 @@ impl CostModel {
                     point_mass: at(below.point_mass, above.point_mass),
                     hybrid: at(below.hybrid, above.hybrid),
                     choice: at(below.choice, above.choice),
+                    floors_only: at(below.floors_only, above.floors_only),
                 });
             }
             below = *above;
@@ -206,6 +228,12 @@ impl Validate for CostModel {
             LevelCosts::MOST_US,
         );
         v.within("contact_search_us", self.contact_search_us, 0.0, LevelCosts::MOST_US);
+        v.within(
+            "floors_only_us_per_creature",
+            self.floors_only_us_per_creature,
+            0.0,
+            LevelCosts::MOST_US,
+        );
         let shares = |v: &mut Validator, shares: &CrowdShares, smallest: u32, why: &str| {
             v.require(
                 shares.creatures >= smallest,
@@ -215,6 +243,7 @@ impl Validate for CostModel {
             v.within("point_mass", shares.point_mass, 0.01, 10.0);
             v.within("hybrid", shares.hybrid, 0.01, 10.0);
             v.within("choice", shares.choice, 0.01, 10.0);
+            v.within("floors_only", shares.floors_only, 0.01, 10.0);
         };
         if let Some(first) = &self.crowd_shares {
             v.nested("crowd_shares", |v| {
@@ -288,7 +317,7 @@ mod tests {
     fn a_crowd_between_two_measured_takes_a_share_between_theirs_on_the_logarithm_of_its_count() {
         let text = format!(
             "(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((creatures: 4096, point_mass: 1.0, hybrid: 1.0)), \
-             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75, choice: 0.5)])"
+             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75, choice: 0.5, floors_only: 2.0)])"
         );
         let mut model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
         // The choice's share too (a share left out is 1): none short of a crowd.
@@ -301,6 +330,11 @@ mod tests {
             model.overhead_us(32_768)
         );
         assert_eq!(model.overhead_us(1_000_000), 0.5 * 2.0 * 1e6);
+        // Where only the floors fit, the choice is its pass, at its own share.
+        model.floors_only_us_per_creature = 0.25;
+        assert_eq!(model.floors_only_overhead_us(100), 25.0);
+        assert_eq!(model.floors_only_overhead_us(1_000_000), 2.0 * 0.25 * 1e6);
+        assert_eq!(model.floors_only_overhead_us(16_384), 0.25 * 16_384.0);
         let point_mass = |n| model.in_crowd("hopper", n).point_mass_us_per_frame;
         // The smallest crowd's share down to the smallest crowd, the largest's beyond it.
         assert_eq!(point_mass(PARALLEL_MIN_CREATURES), 1.0);
@@ -324,6 +358,12 @@ mod tests {
         let unordered = text.replace("creatures: 65536", "creatures: 8192");
         let err = parse_ron::<CostModel>(unordered.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`larger_crowd_shares[1].creatures`"), "{err}");
+        let pass = text.replace("floors_only: 2.0", "floors_only: 0");
+        let err = parse_ron::<CostModel>(pass.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(
+            err.to_string().contains("`larger_crowd_shares[1].floors_only`"),
+            "{err}"
+        );
         let last = text.replace("creatures: 4096", &format!("creatures: {}", u32::MAX));
         let err = parse_ron::<CostModel>(last.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`larger_crowd_shares[0].creatures`"), "{err}");

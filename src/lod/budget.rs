@@ -909,11 +909,12 @@ impl Floors {
         self.cost_us + self.cheapest_step_us <= budget_us
     }
 
-    /// The floors as the allocation, within `budget_us` beside a frame's `fixed_us`.
-    fn allocation<S>(self, budget_us: f32, fixed_us: f32) -> Allocation<S> {
+    /// The floors as the allocation, within `budget_us` beside what a frame costs whatever
+    /// its creatures' levels (`overhead_us`).
+    fn allocation<S>(self, budget_us: f32, overhead_us: f32) -> Allocation<S> {
         Allocation {
-            predicted_us: self.frame_us + fixed_us,
-            exceeded: self.frame_us > budget_us - fixed_us,
+            predicted_us: self.frame_us + overhead_us,
+            exceeded: self.frame_us + overhead_us > budget_us,
             levels: self.levels,
             settled: Vec::new(),
         }
@@ -1380,11 +1381,11 @@ fn decide(
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
     // Where not one step up fits, every creature keeps its floor whatever the benefits: they
-    // are not worked out, nor the creatures listed, and the choice costs a pass over them (a
-    // crowd far over its budget). The frame is over the budget only if it is without the
-    // choice's charge.
+    // are not worked out, nor the creatures listed, and the choice costs the pass over them
+    // above (a crowd far over its budget), charged as such.
     if !floors.any_step_fits(room_us) {
-        return floors.allocation(budget_us, config.costs.overhead_us(0));
+        let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
+        return floors.allocation(budget_us, overhead_us);
     }
     let mut candidates: Vec<Candidate> = (rows.iter().zip(&floors.levels))
         .map(|(&(_, c, &lod, _, choice), &floor)| candidate(c, lod, choice, floor))

@@ -27,6 +27,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         other_kinds: COSTS,
         fixed_us_per_frame: 0.0,
         decision_us_per_creature: 0.0,
+        floors_only_us_per_creature: 0.0,
         contact_search_us: 0.0,
         crowd_shares: None,
         larger_crowd_shares: Vec::new(),
@@ -219,10 +220,12 @@ fn the_fixed_cost_and_the_choice_come_off_the_budget_before_any_creature() {
     assert!(rigid_seen <= 1, "{rigid_seen} rigid at once");
     assert_eq!(sim.summary(0.0).budget.unwrap().decisions_over_budget, 0);
     // An overhead that leaves no room for a step leaves every creature at its cheapest; the
-    // choice is then not made, so it is over budget only where the rest is (580 + 30 us, not
-    // 550 + 30).
-    for (fixed_us, over) in [(550.0, false), (580.0, true)] {
+    // choice is then only its pass over the crowd, charged at its own cost: over budget where
+    // the fixed cost, the 30 point masses and the pass are (550 + 30 + 15 us is not, 550 + 30
+    // + 30 and 580 + 30 are).
+    for (fixed_us, pass_us, over) in [(550.0, 0.5, false), (550.0, 1.0, true), (580.0, 0.0, true)] {
         config.costs.fixed_us_per_frame = fixed_us;
+        config.costs.floors_only_us_per_creature = pass_us;
         let mut sim = HeadlessSim::new(config.clone());
         sim.run_for(3.0);
         let summary = sim.summary(0.0);
@@ -230,6 +233,11 @@ fn the_fixed_cost_and_the_choice_come_off_the_budget_before_any_creature() {
         let budget = summary.budget.unwrap();
         let expected = if over { budget.decisions } else { 0 };
         assert_eq!(budget.decisions_over_budget, expected, "{fixed_us} us: {budget:?}");
+        let predicted_us = fixed_us + 30.0 * (1.0 + pass_us);
+        assert!(
+            (budget.predicted_ms_max * 1e3 - predicted_us).abs() < 0.01,
+            "{predicted_us} us: {budget:?}"
+        );
         assert!(budget.searched_per_decision == 0.0, "{budget:?}");
     }
 }

@@ -500,7 +500,8 @@ fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares
     let config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
     let measured = simlod_lab::bench::calibrate(&config, simlod_lab::bench::Calibration::AtStartUp);
     // Every kind of the scenario, a rigid creature far dearer than a hybrid one; the court
-    // and the puck cost something whatever the creatures, and so does the choice.
+    // and the puck cost something whatever the creatures, and so does the choice; where only
+    // the floors fit, the choice is a pass over the creatures and costs less.
     let kinds: Vec<&str> = measured.kinds.iter().map(|k| k.kind.as_str()).collect();
     assert_eq!(kinds, ["hopper", "biped"]);
     for k in &measured.kinds {
@@ -508,6 +509,11 @@ fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares
     }
     assert!(
         measured.fixed_us_per_frame > 0.0 && measured.decision_us_per_creature > 0.0,
+        "{measured:?}"
+    );
+    assert!(
+        measured.floors_only_us_per_creature > 0.0
+            && measured.floors_only_us_per_creature < measured.decision_us_per_creature,
         "{measured:?}"
     );
     // A crowd of tens of thousands is not measured at start-up: its shares are the file's.

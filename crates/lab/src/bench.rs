@@ -361,12 +361,15 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         kinds: entries,
         fixed_us_per_frame: fixed_us as f32,
         decision_us_per_creature: 0.0,
+        floors_only_us_per_creature: 0.0,
         contact_search_us: 0.0,
         crowd_shares: None,
         larger_crowd_shares: Vec::new(),
     };
-    let (decision_us, search_us) = choice_cost_us(config, &model, cheap_count, (warmup, frames), true);
-    (model.decision_us_per_creature, model.contact_search_us) = (decision_us as f32, search_us as f32);
+    let choice = choice_cost_us(config, &model, cheap_count, (warmup, frames), true);
+    model.decision_us_per_creature = choice.per_creature_us as f32;
+    model.floors_only_us_per_creature = choice.floors_only_us as f32;
+    model.contact_search_us = choice.search_us as f32;
     if how == Calibration::AtStartUp {
         model.crowd_shares = config.costs.crowd_shares;
         model.larger_crowd_shares = config.costs.larger_crowd_shares.clone();
@@ -389,20 +392,27 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     };
     let (point_mass, hybrid) = (shares(LevelPolicy::AllPointMass), shares(LevelPolicy::AllHybrid));
     // The choice's too: in a crowd its per-creature work runs across the cores, and most of
-    // its listing and sorting is by creature, not by search.
-    let choice_us = |count| choice_cost_us(config, &model, count, (warmup, frames.div_ceil(3)), false).0;
-    let choice: Vec<f32> = {
-        let alone = choice_us(cheap_count).max(1e-9);
-        (crowds.iter())
-            .map(|&count| (choice_us(count) / alone).clamp(0.01, 10.0) as f32)
-            .collect()
-    };
+    // its listing and sorting is by creature, not by search. Its pass where only the floors
+    // fit runs on one thread.
+    let choice_at = |count| choice_cost_us(config, &model, count, (warmup, frames.div_ceil(3)), false);
+    let alone = choice_at(cheap_count);
+    let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
+    let choice: Vec<(f32, f32)> = (crowds.iter())
+        .map(|&count| {
+            let crowd = choice_at(count);
+            (
+                share(crowd.per_creature_us, alone.per_creature_us),
+                share(crowd.floors_only_us, alone.floors_only_us),
+            )
+        })
+        .collect();
     let mut measured = (crowds.iter().zip(point_mass.iter().zip(&hybrid)).zip(&choice)).map(
-        |((&creatures, (&point_mass, &hybrid)), &choice)| CrowdShares {
+        |((&creatures, (&point_mass, &hybrid)), &(choice, floors_only))| CrowdShares {
             creatures,
             point_mass,
             hybrid,
             choice,
+            floors_only,
         },
     );
     model.crowd_shares = measured.next();
@@ -425,6 +435,7 @@ fn median_model(models: &[CostModel]) -> CostModel {
         point_mass: median_of(&|m| shares(m).point_mass),
         hybrid: median_of(&|m| shares(m).hybrid),
         choice: median_of(&|m| shares(m).choice),
+        floors_only: median_of(&|m| shares(m).floors_only),
     };
     let first = &models[0];
     let mut model = CostModel {
@@ -437,6 +448,7 @@ fn median_model(models: &[CostModel]) -> CostModel {
         other_kinds: LevelCosts::default(),
         fixed_us_per_frame: median_of(&|m| m.fixed_us_per_frame),
         decision_us_per_creature: median_of(&|m| m.decision_us_per_creature),
+        floors_only_us_per_creature: median_of(&|m| m.floors_only_us_per_creature),
         contact_search_us: median_of(&|m| m.contact_search_us),
         crowd_shares: first
             .crowd_shares
@@ -460,25 +472,35 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
     }
 }
 
-/// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up,
-/// with room for every creature's every step (so nothing is left out): the microseconds per
-/// creature without the search for contacts between creatures (the creatures' weight at 0,
-/// so none needs it), and, `with_searches`, the microseconds per creature searched (else 0).
+/// What the budget policy's own choice costs, microseconds: per creature without the search
+/// for contacts between creatures, per creature where only the floors fit, and per creature
+/// searched.
+struct ChoiceCost {
+    per_creature_us: f64,
+    floors_only_us: f64,
+    search_us: f64,
+}
+
+/// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up:
+/// with room for every creature's every step (so nothing is left out), without the search
+/// for contacts between creatures (the creatures' weight at 0, so none needs it); with no
+/// room for any step (a pass over the crowd); and, `with_searches`, per creature searched
+/// (else 0).
 fn choice_cost_us(
     config: &SimConfig,
     model: &CostModel,
     count: u32,
     (warmup, calls): (usize, usize),
     with_searches: bool,
-) -> (f64, f64) {
+) -> ChoiceCost {
     let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
     for _ in 0..warmup {
         sim.advance_frame();
     }
-    let mut time_choice = |creature_weight: f32| {
+    let mut time_choice = |creature_weight: f32, budget_ms: f32| {
         let world = sim.app.world_mut();
         let mut sim_config = world.resource_mut::<SimConfig>();
-        (sim_config.costs, sim_config.rules.budget.frame_budget_ms) = (model.clone(), f32::MAX);
+        (sim_config.costs, sim_config.rules.budget.frame_budget_ms) = (model.clone(), budget_ms);
         sim_config.rules.budget.creature_weight = creature_weight;
         let mut searched = 0;
         let us = median(
@@ -492,15 +514,20 @@ fn choice_cost_us(
         );
         (us, searched)
     };
-    let (unsearched_us, _) = time_choice(0.0);
-    if !with_searches {
-        return (unsearched_us / f64::from(count.max(1)), 0.0);
+    let per_creature = |us: f64| us / f64::from(count.max(1));
+    let (unsearched_us, _) = time_choice(0.0, f32::MAX);
+    let (floors_only_us, _) = time_choice(0.0, 0.0);
+    let search_us = if with_searches {
+        let (searched_us, searched) = time_choice(config.rules.budget.creature_weight, f32::MAX);
+        (searched_us - unsearched_us).max(0.0) / searched.max(1) as f64
+    } else {
+        0.0
+    };
+    ChoiceCost {
+        per_creature_us: per_creature(unsearched_us),
+        floors_only_us: per_creature(floors_only_us),
+        search_us,
     }
-    let (searched_us, searched) = time_choice(config.rules.budget.creature_weight);
-    (
-        unsearched_us / f64::from(count.max(1)),
-        (searched_us - unsearched_us).max(0.0) / searched.max(1) as f64,
-    )
 }
 
 /// Microseconds per switch into the rigid level (building a creature's bodies): a world of
@@ -536,13 +563,16 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
         })
         .collect();
     lines.push(format!(
-        "a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, and per creature it searches for contacts: {:.2}",
-        model.fixed_us_per_frame, model.decision_us_per_creature, model.contact_search_us
+        "a frame whatever its creatures (court, puck, schedule): {:.1}; the budget policy's choice per creature: {:.3}, where only the floors fit: {:.3}, and per creature it searches for contacts: {:.2}",
+        model.fixed_us_per_frame,
+        model.decision_us_per_creature,
+        model.floors_only_us_per_creature,
+        model.contact_search_us
     ));
     for shares in model.crowd_shares.iter().chain(&model.larger_crowd_shares) {
         lines.push(format!(
-            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}, the choice x {:.2}",
-            shares.creatures, shares.point_mass, shares.hybrid, shares.choice
+            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}, the choice x {:.2}, where only the floors fit x {:.2}",
+            shares.creatures, shares.point_mass, shares.hybrid, shares.choice, shares.floors_only
         ));
     }
     lines
@@ -553,6 +583,6 @@ pub fn costs_file_text(model: &CostModel, command: &str) -> String {
     let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
     let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
     format!(
-        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature and per creature it\n// searches for contacts, in microseconds (medians), measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature (and where only the\n// floors fit) and per creature it searches for contacts, in microseconds (medians), measured\n// by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
     )
 }
