@@ -217,31 +217,36 @@ impl Ord for Step {
 }
 
 impl Step {
-    /// The same order as a key, smallest first, short of the level: steps sorted by it stably,
-    /// in the order of each creature's hull, are in [`Ord`]'s order. A ratio is never negative
-    /// (a step gains), so its sign is left out, and the serial takes only the `serial_bits` the
-    /// largest serial needs: the radix sort passes over fewer bytes.
-    fn order_key(&self, serial_bits: u32) -> u64 {
+    /// The ratio as a key, smallest first (the most benefit per microsecond first). A ratio is
+    /// never negative (a step gains), so its sign is left out.
+    fn descending_ratio(&self) -> u32 {
         debug_assert!(self.ratio.is_sign_positive() && !self.ratio.is_nan(), "{}", self.ratio);
-        let descending = 0x7FFF_FFFF - (self.ratio.to_bits() & 0x7FFF_FFFF);
-        (u64::from(descending) << serial_bits) | u64::from(self.serial)
+        0x7FFF_FFFF - (self.ratio.to_bits() & 0x7FFF_FFFF)
     }
 
-    /// The bits the order key gives the serial, for serials up to `most_serial`.
-    fn serial_bits(most_serial: u32) -> u32 {
-        u32::BITS - most_serial.leading_zeros()
+    /// The same order as a key, smallest first, short of the level: steps sorted by it stably,
+    /// in the order of each creature's hull, are in [`Ord`]'s order.
+    fn order_key(&self) -> u64 {
+        (u64::from(self.descending_ratio()) << u32::BITS) | u64::from(self.serial)
     }
 
-    /// Sorts `steps` into the order they are taken, by their key: a radix sort, stable (so
-    /// each creature's steps stay in the order of its hull).
-    fn sort(steps: &mut [Step], serial_bits: u32) {
-        radsort::sort_by_key(steps, |s| s.order_key(serial_bits));
+    /// Sorts `steps` into the order they are taken, stably (so each creature's steps stay in
+    /// the order of its hull): a radix sort by the ratio alone, then each run of equal ratios
+    /// by serial. The radix sort then passes over four bytes of a key, not six or more, and in
+    /// a crowd's cheap steps (their ratios from the view) equal ratios are few.
+    fn sort(steps: &mut [Step]) {
+        radsort::sort_by_key(steps, Step::descending_ratio);
+        for run in steps.chunk_by_mut(|a, b| a.descending_ratio() == b.descending_ratio()) {
+            if run.len() > 1 {
+                run.sort_by_key(|s| s.serial);
+            }
+        }
     }
 
     /// Lists each sorted by [`Step::sort`], merged into the order one stable sort of them end
     /// to end gives: the earlier list's first among equal keys.
-    fn merge(lists: Vec<Vec<Step>>, serial_bits: u32) -> Vec<Step> {
-        let key = |s: &Step| s.order_key(serial_bits);
+    fn merge(lists: Vec<Vec<Step>>) -> Vec<Step> {
+        let key = Step::order_key;
         let mut lists = lists.into_iter();
         let first = lists.next().unwrap_or_default();
         lists.fold(first, |first, second| {
@@ -318,9 +323,9 @@ fn list_and_allocate<S: Send>(
     settle: impl Fn(usize) -> (f32, S) + Sync,
 ) -> Allocation<S> {
     let mut floors = Floors::with_capacity(candidates.len());
-    candidates.iter().for_each(|c| floors.add(c.into(), c.serial));
+    candidates.iter().for_each(|c| floors.add(c.into()));
     let dear_us = dear_us.unwrap_or_else(|| floors.dear_us(budget_us));
-    let listed = hull.list(candidates, 0, Step::serial_bits(floors.most_serial), dear_us);
+    let listed = hull.list(candidates, 0, dear_us);
     let settled_now = candidates.iter().map(|c| c.settled).collect();
     allocate_listed(candidates, floors, settled_now, listed, budget_us, hull, settle)
 }
@@ -549,10 +554,10 @@ impl Hull {
     /// Every step up the hulls of `candidates` (the first of them the `first` creature), a
     /// creature's steps in turn, the cheap ones sorted ([`Listing`]). A chunk of the creatures
     /// can be listed apart and the chunks merged ([`Listing::merge`]).
-    fn list(&self, candidates: &[Candidate], first: u32, serial_bits: u32, dear_us: f32) -> Listing {
+    fn list(&self, candidates: &[Candidate], first: u32, dear_us: f32) -> Listing {
         let mut listed = Listing::new(dear_us, candidates.len());
         self.list_into(candidates, first, &mut listed);
-        Step::sort(&mut listed.cheap, serial_bits);
+        Step::sort(&mut listed.cheap);
         listed
     }
 
@@ -628,7 +633,7 @@ impl Listing {
 
     /// Chunks listed apart, as one: the cheap steps merged ([`Step::merge`]), each chunk's
     /// dear ones kept apart (the queue merges them as it goes).
-    fn merge(chunks: Vec<Listing>, serial_bits: u32) -> Listing {
+    fn merge(chunks: Vec<Listing>) -> Listing {
         let (dear_us, creatures) = (
             chunks.first().map_or(f32::INFINITY, |c| c.dear_us),
             chunks.iter().map(|c| c.creatures).sum(),
@@ -642,7 +647,7 @@ impl Listing {
         Listing {
             dear_us,
             creatures,
-            cheap: Step::merge(cheap, serial_bits),
+            cheap: Step::merge(cheap),
             dear,
         }
     }
@@ -844,8 +849,6 @@ struct Floors {
     cheapest_step_us: f32,
     /// Whether every creature's levels cost no less than the one below.
     rising: bool,
-    /// The largest serial.
-    most_serial: u32,
 }
 
 /// What one creature at its floor adds to [`Floors`]: the same for every creature of its kind
@@ -880,18 +883,16 @@ impl Floors {
             frame_us: 0.0,
             cheapest_step_us: f32::INFINITY,
             rising: true,
-            most_serial: 0,
         }
     }
 
-    fn add(&mut self, c: AtFloor, serial: u32) {
+    fn add(&mut self, c: AtFloor) {
         self.levels.push(c.floor);
         self.frame_at_us.push(c.frame_at_us);
         self.cost_us += c.cost_us;
         self.frame_us += c.frame_at_us[c.floor as usize];
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
         self.rising &= c.rising;
-        self.most_serial = self.most_serial.max(serial);
     }
 
     /// What a step must need to be dear ([`Listing`]): over a [`DEAR_STEPS`]th of the room the
@@ -1375,7 +1376,7 @@ fn decide(
     let mut rows = Vec::with_capacity(floors.levels.capacity());
     for row in creatures {
         let (_, c, &lod, _, choice) = row;
-        floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize], c.serial);
+        floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
         rows.push(row);
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
@@ -1396,7 +1397,6 @@ fn decide(
         least_per_us: rules.least_benefit_per_ms / 1e3,
         settle_us: config.costs.contact_search_us,
     };
-    let serial_bits = Step::serial_bits(floors.most_serial);
     // Each creature's bounds and steps are its own, worked out and listed across the cores,
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
     // the cores a block at a time in turn: what one costs here depends on where it is (in view
@@ -1434,11 +1434,11 @@ fn decide(
                 }
                 hull.list_into(candidates, first, &mut listing);
             }
-            Step::sort(&mut listing.cheap, serial_bits);
+            Step::sort(&mut listing.cheap);
             *listed = Some(listing);
         }
     }));
-    let listed = Listing::merge(chunks.into_iter().flatten().collect(), serial_bits);
+    let listed = Listing::merge(chunks.into_iter().flatten().collect());
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut candidates, floors, settled_now, listed, room_us, &hull, |i| {
         let (_, c, _, s, _) = rows[i];
@@ -1627,7 +1627,7 @@ mod tests {
 
     fn floors_of(crowd: &[Candidate]) -> Floors {
         let mut floors = Floors::with_capacity(crowd.len());
-        crowd.iter().for_each(|c| floors.add(c.into(), c.serial));
+        crowd.iter().for_each(|c| floors.add(c.into()));
         floors
     }
 
@@ -1783,16 +1783,11 @@ mod tests {
                 settle_us,
             };
             let mut floors = Floors::with_capacity(crowd.len());
-            crowd.iter().for_each(|c| floors.add(c.into(), c.serial));
+            crowd.iter().for_each(|c| floors.add(c.into()));
             // Room for a few steps to rigid (and with the least, for a few hybrid ones), to many.
             for room_us in [50.0, 500.0, 5000.0, 50_000.0] {
                 let budget_us = floors.cost_us + room_us;
-                let listing = hull.list(
-                    crowd,
-                    0,
-                    Step::serial_bits(floors.most_serial),
-                    floors.dear_us(budget_us),
-                );
+                let listing = hull.list(crowd, 0, floors.dear_us(budget_us));
                 assert!(listing.dear.iter().any(|(_, dear)| dear.steps.len() > 300));
                 let lazy = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
                 let sorted = list_and_allocate(&mut crowd.clone(), budget_us, &hull, Some(f32::INFINITY), |i| {
@@ -2051,17 +2046,16 @@ mod tests {
                     }
                 })
                 .collect();
-            let serial_bits = Step::serial_bits(most_serial);
             let chunks = steps
                 .chunks(count as usize / 3 + 1)
                 .map(|chunk| {
                     let mut chunk = chunk.to_vec();
-                    Step::sort(&mut chunk, serial_bits);
+                    Step::sort(&mut chunk);
                     chunk
                 })
                 .collect();
-            let merged = Step::merge(chunks, serial_bits);
-            Step::sort(&mut steps, serial_bits);
+            let merged = Step::merge(chunks);
+            Step::sort(&mut steps);
             for steps in [steps, merged] {
                 assert!(
                     steps
