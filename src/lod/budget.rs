@@ -97,33 +97,36 @@ impl Candidate<'_> {
     /// each priced once in `p`: it is listed for every creature at every decision.
     fn step_from(&self, creature: u32, at: Lod, hull: &Hull, p: &Priced) -> Option<Step> {
         let (cost, value) = (p.cost_us[at as usize], p.value[at as usize]);
-        let (mut best, mut best_ratio) = (None, f32::NEG_INFINITY);
+        // None found while `best` is `at`. A ratio is positive or infinite, never NaN.
+        let (mut best, mut best_ratio) = (at, f32::NEG_INFINITY);
         // After its search, only a step that gains can follow a bound.
         let mut after_search_us = f32::INFINITY;
-        // Only a level above can be a step up.
-        for &to in self.levels.iter().filter(|&&to| to > at) {
+        for &to in self.levels {
+            // Only a level above can be a step up.
+            if to <= at {
+                continue;
+            }
             let (to_cost, to_value) = (p.cost_us[to as usize], p.value[to as usize]);
-            let gains = to_value > value;
+            let (gains, extra_us) = (to_value > value, to_cost - cost);
             if gains || to == Lod::Rigid {
-                after_search_us = after_search_us.min(to_cost - cost);
+                after_search_us = after_search_us.min(extra_us);
             }
             if !gains {
                 continue;
             }
-            let extra_us = to_cost - cost;
             let ratio = if extra_us > 0.0 {
                 (to_value - value) / extra_us
             } else {
                 f32::INFINITY
             };
-            let better = ratio
-                .total_cmp(&best_ratio)
-                .then(best.map_or(std::cmp::Ordering::Greater, |b: Lod| b.cmp(&to)));
-            if better.is_gt() {
-                (best, best_ratio) = (Some(to), ratio);
+            if ratio > best_ratio || (ratio == best_ratio && to < best) {
+                (best, best_ratio) = (to, ratio);
             }
         }
-        let to = best.filter(|_| best_ratio >= hull.least_per_us)?;
+        if best == at || best_ratio < hull.least_per_us {
+            return None;
+        }
+        let to = best;
         // Only the rigid benefit is ever a bound: a step to another level is exact.
         let bound = !self.settled && to == Lod::Rigid;
         let running = |l: Lod| p.cost_us[l.max(self.current) as usize];
