@@ -1063,12 +1063,35 @@ fn decay(x: f32) -> f32 {
 /// The first ring of the search for the soonest contact with another creature, m.
 const NEAREST_RING_M: f32 = 4.0;
 
+/// A circle a creature may meet, and how fast a creature can close on it at most.
+struct Circle {
+    area: Area,
+    closing_m_per_s: f32,
+}
+
+impl Circle {
+    /// The puck and the host's `areas` of influence (weighed as the puck is), for creatures
+    /// of at most `top_speed`: each one's closing speed worked out once a decision.
+    fn of(puck: &PuckState, areas: Vec<Area>, top_speed: f32) -> Vec<Circle> {
+        let puck = Area {
+            position: puck.position,
+            velocity: puck.velocity,
+            radius_m: puck.radius_m,
+        };
+        (std::iter::once(puck).chain(areas))
+            .map(|area| Circle {
+                closing_m_per_s: (top_speed + area.velocity.length()).max(1e-3),
+                area,
+            })
+            .collect()
+    }
+}
+
 /// What the benefits are computed from at one decision.
 struct Scene<'a> {
     rules: &'a BudgetRules,
-    puck: &'a PuckState,
-    /// The host's areas of influence, weighed as the puck is.
-    areas: Vec<Area>,
+    /// The puck, then the host's areas of influence.
+    circles: Vec<Circle>,
     court: &'a Court,
     grid: &'a NeighbourGrid,
     camera: &'a SimCamera,
@@ -1091,16 +1114,15 @@ impl Scene<'_> {
         decay(-t_course / h).max(self.rules.worst_case_share * decay(-t_worst / h))
     }
 
-    /// When a contact could come with a circle of `circle_radius` at `centre` moving at
-    /// `velocity`.
-    fn circle(&self, s: &PlanarState, radius: f32, centre: Vec2, velocity: Vec2, circle_radius: f32) -> ContactTimes {
-        let d = s.position - centre;
-        let reach = radius + circle_radius + self.rules.contact_margin_m;
+    /// When a contact could come with `circle`.
+    fn circle(&self, s: &PlanarState, radius: f32, circle: &Circle) -> ContactTimes {
+        let c = &circle.area;
+        let d = s.position - c.position;
+        let reach = radius + c.radius_m + self.rules.contact_margin_m;
         let gap = (d.length() - reach).max(0.0);
-        let closing = self.top_speed + velocity.length();
         ContactTimes {
-            course_s: time_to_contact(d, s.velocity - velocity, reach),
-            worst_s: gap / closing.max(1e-3),
+            course_s: time_to_contact(d, s.velocity - c.velocity, reach),
+            worst_s: gap / circle.closing_m_per_s,
         }
     }
 
@@ -1127,10 +1149,10 @@ impl Scene<'_> {
     fn near(&self, s: &PlanarState, radius: f32) -> Near {
         let margin = self.rules.contact_margin_m;
         // The puck, and the host's areas of influence.
-        let puck = self.puck;
-        let mut soonest = self.circle(s, radius, puck.position, puck.velocity, puck.radius_m);
-        for a in &self.areas {
-            soonest = soonest.sooner(self.circle(s, radius, a.position, a.velocity, a.radius_m));
+        let (puck, areas) = self.circles.split_first().expect("the puck is a circle");
+        let mut soonest = self.circle(s, radius, puck);
+        for a in areas {
+            soonest = soonest.sooner(self.circle(s, radius, a));
         }
         // The walls: the nearest on each axis.
         let room = self.court.half_extents - Vec2::splat(radius + margin) - s.position.abs();
@@ -1467,8 +1489,7 @@ fn scene<'a>(
     let biggest = kinds.0.iter().map(|k| k.radius_m).fold(0.0, f32::max);
     Scene {
         rules,
-        puck,
-        areas,
+        circles: Circle::of(puck, areas, top_speed),
         court,
         grid,
         camera,
@@ -1897,8 +1918,7 @@ mod tests {
     ) -> Scene<'a> {
         Scene {
             rules: b,
-            puck,
-            areas: Vec::new(),
+            circles: Circle::of(puck, Vec::new(), 3.0),
             court,
             grid,
             camera,
