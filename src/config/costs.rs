@@ -68,7 +68,7 @@ pub struct CrowdShares {
     #[serde(default = "CrowdShares::whole")]
     pub choice: f32,
     /// Of the choice's pass where only the floors fit (a file without it: 1). The pass runs
-    /// on one thread, and a large crowd's creatures are further apart in memory: above 1.
+    /// on one thread in any crowd, so its share stays near 1.
     #[serde(default = "CrowdShares::whole")]
     pub floors_only: f32,
 }
