@@ -149,10 +149,16 @@ impl Candidate<'_> {
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
     fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, listed: &mut Listing) {
+        let top = self.levels.iter().max().copied();
         let mut next = self.step_from(creature, self.floor, hull, p);
         while let Some(step) = next {
             listed.push(step, hull);
-            next = self.step_from(creature, step.to, hull, p);
+            // Nothing is above its kind's top level.
+            next = if Some(step.to) == top {
+                None
+            } else {
+                self.step_from(creature, step.to, hull, p)
+            };
         }
     }
 
@@ -560,12 +566,12 @@ impl Hull {
     fn list(&self, candidates: &[Candidate], first: u32, dear_us: f32) -> Listing {
         let mut listed = Listing::new(dear_us, candidates.len());
         self.list_into(candidates, first, &mut listed);
-        Step::sort(&mut listed.cheap);
+        listed.finish();
         listed
     }
 
-    /// [`Hull::list`] into `listed`, the cheap steps left unsorted: a block of the creatures
-    /// listed among others.
+    /// [`Hull::list`] into `listed`, left unfinished ([`Listing::finish`]): a block of the
+    /// creatures listed among others.
     fn list_into(&self, candidates: &[Candidate], first: u32, listed: &mut Listing) {
         for (i, c) in (first..).zip(candidates) {
             c.list_hull(i, self, &c.priced(self.hysteresis), listed);
@@ -594,10 +600,13 @@ struct Listing {
     cheap: Vec<Step>,
     /// By whether they are bounds and the bits of what they add; a chunk's apart.
     dear: Vec<((bool, u32), DearSteps)>,
+    /// The dear list last pushed to: a crowd's creatures of a kind list into the same rooms.
+    last_dear: usize,
 }
 
 /// The dear steps that need one room, as listed, and the best of them: the head of their list
-/// in the queue before it is put in order (most dear lists are never taken from).
+/// in the queue before it is put in order (most dear lists are never taken from). The best is
+/// found once the listing is done ([`Listing::finish`]).
 struct DearSteps {
     steps: Vec<Step>,
     best: Step,
@@ -611,6 +620,7 @@ impl Listing {
             creatures,
             cheap: Vec::with_capacity(2 * creatures),
             dear: Vec::new(),
+            last_dear: 0,
         }
     }
 
@@ -619,18 +629,41 @@ impl Listing {
             return self.cheap.push(step);
         }
         let room = (step.bound, step.extra_us.to_bits());
-        match self.dear.iter_mut().find(|(r, _)| *r == room) {
-            Some((_, dear)) => {
-                dear.best = dear.best.max(step);
-                dear.steps.push(step);
+        let last = self.dear.get(self.last_dear).filter(|(r, _)| *r == room);
+        match last
+            .map(|_| self.last_dear)
+            .or_else(|| self.dear.iter().position(|(r, _)| *r == room))
+        {
+            Some(i) => {
+                self.dear[i].1.steps.push(step);
+                self.last_dear = i;
             }
             None => {
                 // Room for a step of each creature: a creature lists one in a room at most, but
                 // in a crowd where two of its levels cost alike.
                 let mut steps = Vec::with_capacity(self.creatures);
                 steps.push(step);
+                self.last_dear = self.dear.len();
                 self.dear.push((room, DearSteps { steps, best: step }));
             }
+        }
+    }
+
+    /// Done listing: the cheap steps sorted, and each dear list's best found. A creature lists
+    /// one step in a room, so within a dear list the ratio and the serial order the steps (the
+    /// first listed kept among equals, as the hull's lower level would be).
+    fn finish(&mut self) {
+        Step::sort(&mut self.cheap);
+        let key = |s: &Step| (u64::from(0x7FFF_FFFF - s.descending_ratio()) << u32::BITS) | u64::from(!s.serial);
+        for (_, dear) in &mut self.dear {
+            let mut best = (key(&dear.best), dear.best);
+            for step in &dear.steps[1..] {
+                let k = key(step);
+                if k > best.0 {
+                    best = (k, *step);
+                }
+            }
+            dear.best = best.1;
         }
     }
 
@@ -652,6 +685,7 @@ impl Listing {
             creatures,
             cheap: Step::merge(cheap),
             dear,
+            last_dear: 0,
         }
     }
 }
@@ -1459,7 +1493,7 @@ fn decide(
                 }
                 hull.list_into(candidates, first, &mut listing);
             }
-            Step::sort(&mut listing.cheap);
+            listing.finish();
             *listed = Some(listing);
         }
     }));
@@ -1794,6 +1828,35 @@ mod tests {
                 charged.predicted_us
             );
         }
+    }
+
+    #[test]
+    fn a_dear_lists_head_is_its_best_step_whatever_the_order_listed() {
+        // Hybrids stepping to rigid (98 us, dear beside a room of 1 ms): few rigid benefits, so
+        // many equal ratios, the lower serial first among them; serials listed out of order.
+        let mut next = uniform(7);
+        let crowd: Vec<Candidate> = (0..2000)
+            .map(|i| candidate((i * 7919) % 2000, Lod::Hybrid, 1.0 + (next() * 4.0).floor()))
+            .collect();
+        let hull = Hull {
+            hysteresis: 0.0,
+            least_per_us: 0.0,
+            settle_us: 0.0,
+        };
+        let listing = hull.list(&crowd, 0, 1.0);
+        assert_eq!(listing.dear.len(), 1);
+        let (_, dear) = &listing.dear[0];
+        assert_eq!(dear.steps.len(), crowd.len());
+        let best = dear.steps.iter().max().unwrap();
+        assert_eq!((dear.best.serial, dear.best.ratio), (best.serial, best.ratio));
+        let most = dear.steps.iter().map(|s| s.ratio).fold(0.0, f32::max);
+        let first = dear.steps.iter().filter(|s| s.ratio == most).map(|s| s.serial).min();
+        assert_eq!(
+            Some(dear.best.serial),
+            first,
+            "the lowest serial among the greatest ratio"
+        );
+        assert!(dear.steps.iter().filter(|s| s.ratio == most).count() > 100);
     }
 
     #[test]
