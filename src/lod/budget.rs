@@ -174,6 +174,28 @@ impl Candidate<'_> {
     }
 }
 
+/// The creatures the knapsack chooses among, each a [`Candidate`] by its place: a slice of
+/// them, or a decision's creatures, each made only when asked for (in a crowd, the few the
+/// queue comes back to).
+trait Crowd<'a>: Sync {
+    /// The `i`-th, its rigid benefit exact once settled.
+    fn candidate(&self, i: usize) -> Candidate<'a>;
+    /// The `i`-th's exact rigid benefit, settled.
+    fn settle(&mut self, i: usize, rigid_benefit: f32);
+}
+
+impl<'a> Crowd<'a> for [Candidate<'a>] {
+    fn candidate(&self, i: usize) -> Candidate<'a> {
+        self[i].clone()
+    }
+
+    fn settle(&mut self, i: usize, rigid_benefit: f32) {
+        let c = &mut self[i];
+        c.benefit[Lod::Rigid as usize] = rigid_benefit;
+        c.settled = true;
+    }
+}
+
 /// A candidate's levels priced for the knapsack, by `Lod as usize`: what each costs (as
 /// `Candidate::cost_us`) and is worth (as `Candidate::value`).
 struct Priced {
@@ -342,8 +364,8 @@ fn list_and_allocate<S: Send>(
 /// [`allocate`] from every creature at its floor (`floors`), whether each is `settled_now`, and
 /// the steps up their hulls `listed` ([`Hull::list`], its dear steps beyond the room in the
 /// budget the floors leave over [`DEAR_STEPS`]).
-fn allocate_listed<S: Send>(
-    candidates: &mut [Candidate],
+fn allocate_listed<'a, S: Send>(
+    crowd: &mut (impl Crowd<'a> + ?Sized),
     floors: Floors,
     mut settled_now: Vec<bool>,
     listed: Listing,
@@ -359,7 +381,7 @@ fn allocate_listed<S: Send>(
     let (mut levels, mut spent, mut running_us) = (floors.levels, floors.cost_us, floors.frame_us);
     let (cheapest_us, rising, settle_us) = (floors.cheapest_step_us, floors.rising, hull.settle_us);
     // The queue: the lists of steps, merged as it goes, best first.
-    let threads = threads_for(candidates.len() as u32);
+    let threads = threads_for(levels.len() as u32);
     let mut lists: Vec<Queued<S>> = Vec::new();
     if spent + cheapest_us <= budget_us {
         lists.push(Queued::cheap(listed.cheap, hull, threads));
@@ -472,15 +494,12 @@ fn allocate_listed<S: Send>(
                 let at = q.next - 1;
                 q.sort_to(at + 1 + q.ahead.batch);
                 let sorted = &q.steps[..q.sorted];
-                let now = q
-                    .ahead
-                    .take(at, sorted, candidates, &settled_now, hull, room_us, &settle);
+                let now = q.ahead.take(at, sorted, &*crowd, &settled_now, hull, room_us, &settle);
                 spent += settle_us;
                 running_us += settle_us;
                 settled.push((creature, now.kept));
-                let c = &mut candidates[creature];
-                c.benefit[Lod::Rigid as usize] = now.benefit;
-                (c.settled, settled_now[creature]) = (true, true);
+                crowd.settle(creature, now.benefit);
+                settled_now[creature] = true;
                 follows.push(now.step);
             }
         } else if spent + step.extra_us <= budget_us {
@@ -490,7 +509,7 @@ fn allocate_listed<S: Send>(
             taken.push(step);
             // A listed step's successor is listed too.
             if followed {
-                let c = &candidates[creature];
+                let c = crowd.candidate(creature);
                 follows.push(c.step_from(step.creature, step.to, hull, &c.priced(hull.hysteresis)));
             }
         }
@@ -565,17 +584,11 @@ impl Hull {
     /// can be listed apart and the chunks merged ([`Listing::merge`]).
     fn list(&self, candidates: &[Candidate], first: u32, dear_us: f32) -> Listing {
         let mut listed = Listing::new(dear_us, candidates.len());
-        self.list_into(candidates, first, &mut listed);
+        for (i, c) in (first..).zip(candidates) {
+            c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
+        }
         listed.finish();
         listed
-    }
-
-    /// [`Hull::list`] into `listed`, left unfinished ([`Listing::finish`]): a block of the
-    /// creatures listed among others.
-    fn list_into(&self, candidates: &[Candidate], first: u32, listed: &mut Listing) {
-        for (i, c) in (first..).zip(candidates) {
-            c.list_hull(i, self, &c.priced(self.hysteresis), listed);
-        }
     }
 
     /// The room in the budget a step needs to change anything: a bound's search beside it.
@@ -813,11 +826,11 @@ impl<S: Send> SettledAhead<S> {
     /// unsettled bounds in the list, no more than `room_us` could pay for (on one thread, it
     /// alone).
     #[allow(clippy::too_many_arguments)]
-    fn take(
+    fn take<'a>(
         &mut self,
         at: usize,
         listed: &[Step],
-        candidates: &[Candidate],
+        crowd: &(impl Crowd<'a> + ?Sized),
         settled_now: &[bool],
         hull: &Hull,
         room_us: f32,
@@ -849,7 +862,7 @@ impl<S: Send> SettledAhead<S> {
                     for (&i, m) in places.iter().zip(made) {
                         let step = &listed[i];
                         let (benefit, kept) = settle(step.creature as usize);
-                        let mut c = candidates[step.creature as usize].clone();
+                        let mut c = crowd.candidate(step.creature as usize);
                         c.benefit[Lod::Rigid as usize] = benefit;
                         c.settled = true;
                         let step = c.step_from(step.creature, step.from, hull, &c.priced(hull.hysteresis));
@@ -1397,19 +1410,6 @@ fn decide(
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
         if dwelling { lod } else { kinds[c.kind].levels[0] }
     };
-    let candidate = |c: &Creature, lod: Lod, choice: &LevelChoice, floor: Lod| {
-        let kind = &kinds[c.kind];
-        Candidate {
-            serial: c.serial,
-            current: lod,
-            last: choice.wanted,
-            floor,
-            levels: &kind.levels,
-            costs: costs[c.kind],
-            benefit: [0.0; 3],
-            settled: true,
-        }
-    };
     // Each kind at each floor and level, once.
     let at_floor: Vec<[[AtFloor; 3]; 3]> = (kinds.0.iter().zip(&costs))
         .map(|(kind, &costs)| {
@@ -1447,14 +1447,30 @@ fn decide(
         let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
         return floors.allocation(budget_us, overhead_us);
     }
-    let mut candidates: Vec<Candidate> = (rows.iter().zip(&floors.levels))
-        .map(|(&(_, c, &lod, _, choice), &floor)| candidate(c, lod, choice, floor))
-        .collect();
     let rules = &config.rules.budget;
     let hull = Hull {
         hysteresis: rules.hysteresis,
         least_per_us: rules.least_benefit_per_ms / 1e3,
         settle_us: config.costs.contact_search_us,
+    };
+    // A creature as the knapsack sees it, made from what this decision gathered of it: where
+    // its bounds are worked out, and again only for the few the queue comes back to.
+    let made = |&(_, c, &lod, _, choice): &(Entity, &Creature, &Lod, &PlanarState, &LevelChoice),
+                floor: Lod,
+                bound: &Bounds| {
+        // A search within `contact_recheck_s` stands; without one, any contact with another
+        // creature could be now.
+        let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
+        Candidate {
+            serial: c.serial,
+            current: lod,
+            last: choice.wanted,
+            floor,
+            levels: &kinds[c.kind].levels,
+            costs: costs[c.kind],
+            benefit: [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))],
+            settled: standing.is_some() || bound.settled(scene),
+        }
     };
     // Each creature's bounds and steps are its own, worked out and listed across the cores,
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
@@ -1467,46 +1483,67 @@ fn decide(
         .div_ceil(chunk_len(config.scenario.creature_count(), rows.len()));
     let dear_us = floors.dear_us(room_us);
     let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
-    let blocks = (rows.chunks(DEALT_BLOCK).zip(candidates.chunks_mut(DEALT_BLOCK)))
+    let blocks = (rows.chunks(DEALT_BLOCK).zip(floors.levels.chunks(DEALT_BLOCK)))
         .zip(bounds.chunks_mut(DEALT_BLOCK).zip(settled_now.chunks_mut(DEALT_BLOCK)));
     for (b, block) in blocks.enumerate() {
         dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
     }
     let mut chunks: Vec<Option<Listing>> = (0..threads).map(|_| None).collect();
     run_chunks(dealt.into_iter().zip(chunks.iter_mut()).map(|(blocks, listed)| {
-        let hull = &hull;
+        let (hull, made) = (&hull, &made);
         move || {
             let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, ((rows, _), _))| rows.len()).sum());
-            for (first, ((rows, candidates), (bounds, settled_now))) in blocks {
-                let creatures = rows
-                    .iter()
-                    .zip(candidates.iter_mut())
-                    .zip(bounds.iter_mut().zip(settled_now));
-                for ((&(entity, c, _, s, choice), candidate), (bound, settled)) in creatures {
+            for (first, ((rows, floors), (bounds, settled_now))) in blocks {
+                let creatures = (rows.iter().zip(floors)).zip(bounds.iter_mut().zip(settled_now));
+                for ((row, (&floor, (bound, settled))), i) in creatures.map(|((r, f), b)| (r, (f, b))).zip(first..) {
+                    let (entity, c, _, s, _) = *row;
                     *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
-                    // A search within `contact_recheck_s` stands; without one, any contact with
-                    // another creature could be now.
-                    let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
-                    candidate.benefit = [0.0, bound.hybrid, bound.rigid(scene, standing.map_or(1.0, |s| s.0))];
-                    candidate.settled = standing.is_some() || bound.settled(scene);
+                    let candidate = made(row, floor, bound);
                     *settled = candidate.settled;
+                    candidate.list_hull(i, hull, &candidate.priced(hull.hysteresis), &mut listing);
                 }
-                hull.list_into(candidates, first, &mut listing);
             }
             listing.finish();
             *listed = Some(listing);
         }
     }));
     let listed = Listing::merge(chunks.into_iter().flatten().collect());
+    let floor_levels = floors.levels.clone();
+    let mut crowd = Gathered {
+        made: |i: usize| made(&rows[i], floor_levels[i], &bounds[i]),
+        settled: Default::default(),
+    };
     // Only a creature that could still buy a level is searched for contacts with the others.
-    let mut allocation = allocate_listed(&mut candidates, floors, settled_now, listed, room_us, &hull, |i| {
+    let mut allocation = allocate_listed(&mut crowd, floors, settled_now, listed, room_us, &hull, |i| {
         let (_, c, _, s, _) = rows[i];
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
         (bounds[i].rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
-    allocation.predicted_us += config.costs.overhead_us(candidates.len());
+    allocation.predicted_us += config.costs.overhead_us(rows.len());
     allocation
+}
+
+/// A decision's creatures as the knapsack sees them ([`Crowd`]): each `made` from what the
+/// decision gathered of it when asked for, its rigid benefit once `settled`.
+struct Gathered<F> {
+    made: F,
+    settled: std::collections::HashMap<usize, f32>,
+}
+
+impl<'a, F: Fn(usize) -> Candidate<'a> + Sync> Crowd<'a> for Gathered<F> {
+    fn candidate(&self, i: usize) -> Candidate<'a> {
+        let mut c = (self.made)(i);
+        if let Some(&rigid_benefit) = self.settled.get(&i) {
+            c.benefit[Lod::Rigid as usize] = rigid_benefit;
+            c.settled = true;
+        }
+        c
+    }
+
+    fn settle(&mut self, i: usize, rigid_benefit: f32) {
+        self.settled.insert(i, rigid_benefit);
+    }
 }
 
 fn scene<'a>(
