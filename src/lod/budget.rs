@@ -32,12 +32,13 @@ use super::{LevelPolicy, Lod};
 use crate::config::{BudgetRules, LevelCosts, SimConfig};
 use crate::contract::GaitPose;
 use crate::contract::SimClock;
+use crate::contract::{DENSE, chunk_len, run_chunks, threads_for};
 use crate::contract::{GaitPhase, PlanarState};
 use crate::contract::{SimStage, SimStart, StartStage};
-use crate::contract::{chunk_len, run_chunks, threads_for};
 use crate::kind::{Creature, KindTable, starting_gait};
 use crate::sense::NeighbourGrid;
 use crate::sense::{Court, PuckState};
+use bevy::ecs::query::QueryData;
 
 /// One creature as the knapsack sees it.
 #[derive(Clone, Debug)]
@@ -1358,17 +1359,15 @@ impl Bounds {
     }
 }
 
-type Creatures<'w, 's> = Query<
-    'w,
-    's,
-    (
-        Entity,
-        &'static Creature,
-        &'static Lod,
-        &'static PlanarState,
-        &'static mut LevelChoice,
-    ),
->;
+type CreatureRow = (
+    Entity,
+    &'static Creature,
+    &'static Lod,
+    &'static PlanarState,
+    &'static mut LevelChoice,
+);
+
+type Creatures<'w, 's> = Query<'w, 's, CreatureRow>;
 
 /// One decision of the budget policy, in the query's order: settled are the creatures searched
 /// for contacts with others (by their place in the query, in order), and how urgent their
@@ -1430,13 +1429,12 @@ fn decide(
             })
         })
         .collect();
-    // The creatures gathered in the same pass.
-    let mut floors = Floors::with_capacity(creatures.iter().len());
-    let mut rows = Vec::with_capacity(floors.levels.capacity());
-    for row in creatures {
-        let (_, c, &lod, _, choice) = row;
+    let readonly = creatures.as_readonly();
+    let tables = Tables::of(&readonly);
+    let count = tables.len();
+    let mut floors = Floors::with_capacity(count);
+    for (_, c, &lod, _, choice) in tables.rows(0, count) {
         floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
-        rows.push(row);
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
     let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
@@ -1455,9 +1453,7 @@ fn decide(
     };
     // A creature as the knapsack sees it, made from what this decision gathered of it: where
     // its bounds are worked out, and again only for the few the queue comes back to.
-    let made = |&(_, c, &lod, _, choice): &(Entity, &Creature, &Lod, &PlanarState, &LevelChoice),
-                floor: Lod,
-                bound: &Bounds| {
+    let made = |(_, c, &lod, _, choice): Row, floor: Lod, bound: &Bounds| {
         // A search within `contact_recheck_s` stands; without one, any contact with another
         // creature could be now.
         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
@@ -1476,27 +1472,26 @@ fn decide(
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
     // the cores a block at a time in turn: what one costs here depends on where it is (in view
     // or not), and the query keeps neighbours together, so that halves of it would not balance.
-    let mut bounds = vec![Bounds::default(); rows.len()];
-    let mut settled_now = vec![false; rows.len()];
-    let threads = rows
-        .len()
-        .div_ceil(chunk_len(config.scenario.creature_count(), rows.len()));
+    let mut bounds = vec![Bounds::default(); count];
+    let mut settled_now = vec![false; count];
+    let threads = count.div_ceil(chunk_len(config.scenario.creature_count(), count));
     let dear_us = floors.dear_us(room_us);
     let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
-    let blocks = (rows.chunks(DEALT_BLOCK).zip(floors.levels.chunks(DEALT_BLOCK)))
+    let blocks = (floors.levels.chunks(DEALT_BLOCK))
         .zip(bounds.chunks_mut(DEALT_BLOCK).zip(settled_now.chunks_mut(DEALT_BLOCK)));
     for (b, block) in blocks.enumerate() {
         dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
     }
     let mut chunks: Vec<Option<Listing>> = (0..threads).map(|_| None).collect();
     run_chunks(dealt.into_iter().zip(chunks.iter_mut()).map(|(blocks, listed)| {
-        let (hull, made) = (&hull, &made);
+        let (hull, made, tables) = (&hull, &made, &tables);
         move || {
-            let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, ((rows, _), _))| rows.len()).sum());
-            for (first, ((rows, floors), (bounds, settled_now))) in blocks {
-                let creatures = (rows.iter().zip(floors)).zip(bounds.iter_mut().zip(settled_now));
-                for ((row, (&floor, (bound, settled))), i) in creatures.map(|((r, f), b)| (r, (f, b))).zip(first..) {
-                    let (entity, c, _, s, _) = *row;
+            let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, (floors, _))| floors.len()).sum());
+            for (first, (floors, (bounds, settled_now))) in blocks {
+                let rows = tables.rows(first as usize, first as usize + floors.len());
+                let creatures = rows.zip(floors.iter().zip(bounds.iter_mut().zip(settled_now)));
+                for ((row, (&floor, (bound, settled))), i) in creatures.zip(first..) {
+                    let (entity, c, _, s, _) = row;
                     *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
                     let candidate = made(row, floor, bound);
                     *settled = candidate.settled;
@@ -1510,18 +1505,69 @@ fn decide(
     let listed = Listing::merge(chunks.into_iter().flatten().collect());
     let floor_levels = floors.levels.clone();
     let mut crowd = Gathered {
-        made: |i: usize| made(&rows[i], floor_levels[i], &bounds[i]),
+        made: |i: usize| made(tables.row(i), floor_levels[i], &bounds[i]),
         settled: Default::default(),
     };
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut crowd, floors, settled_now, listed, room_us, &hull, |i| {
-        let (_, c, _, s, _) = rows[i];
+        let (_, c, _, s, _) = tables.row(i);
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
         (bounds[i].rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
-    allocation.predicted_us += config.costs.overhead_us(rows.len());
+    allocation.predicted_us += config.costs.overhead_us(count);
     allocation
+}
+
+/// A creature as a decision reads it.
+type Row<'w> = (Entity, &'w Creature, &'w Lod, &'w PlanarState, &'w LevelChoice);
+
+/// A decision's creatures, read table by table where the query holds them: each core reads
+/// its own, where a row apiece gathered on one core first cost a pass over the crowd.
+struct Tables<'w> {
+    tables: Vec<(
+        &'w [Entity],
+        &'w [Creature],
+        &'w [Lod],
+        &'w [PlanarState],
+        &'w [LevelChoice],
+    )>,
+    /// Where each table's rows start, then how many there are in all.
+    starts: Vec<usize>,
+}
+
+impl<'w> Tables<'w> {
+    fn of(creatures: &'w Query<'_, '_, <CreatureRow as QueryData>::ReadOnly>) -> Self {
+        let tables: Vec<_> = creatures.contiguous_iter().expect(DENSE).collect();
+        let starts = std::iter::once(0)
+            .chain(tables.iter().scan(0, |sum, t| {
+                *sum += t.0.len();
+                Some(*sum)
+            }))
+            .collect();
+        Self { tables, starts }
+    }
+
+    fn len(&self) -> usize {
+        self.starts.last().copied().unwrap_or(0)
+    }
+
+    /// The rows `from..to`, in the query's order.
+    fn rows(&self, from: usize, to: usize) -> impl Iterator<Item = Row<'w>> + '_ {
+        // The last table starting at or before `from` holds it (an empty one never does).
+        let first = self.starts.partition_point(|&s| s <= from).saturating_sub(1);
+        (self.tables[first.min(self.tables.len())..]
+            .iter()
+            .zip(&self.starts[first..]))
+        .flat_map(move |(&(entity, c, lod, s, choice), &start)| {
+            let (a, b) = (from.max(start) - start, to.min(start + entity.len()).max(start) - start);
+            (a..b.max(a)).map(move |j| (entity[j], &c[j], &lod[j], &s[j], &choice[j]))
+        })
+    }
+
+    fn row(&self, i: usize) -> Row<'w> {
+        self.rows(i, i + 1).next().expect("a row of the decision")
+    }
 }
 
 /// A decision's creatures as the knapsack sees them ([`Crowd`]): each `made` from what the
@@ -1718,6 +1764,47 @@ mod tests {
             benefit: [0.0, 0.5, rigid_benefit],
             settled: true,
         }
+    }
+
+    #[test]
+    fn a_decisions_rows_are_read_across_its_tables_in_order_from_anywhere() {
+        // Tables of 3, none, 2 and 4 creatures, each told apart by its serial.
+        let lens = [3usize, 0, 2, 4];
+        let creatures: Vec<Vec<Creature>> = (lens.iter().scan(0, |n, &len| {
+            *n += len;
+            Some(*n - len)
+        }))
+        .zip(lens)
+        .map(|(first, len)| {
+            (first..first + len)
+                .map(|i| Creature {
+                    kind: 0,
+                    serial: i as u32,
+                })
+                .collect()
+        })
+        .collect();
+        let (entities, lods, states, choices) = (
+            [Entity::PLACEHOLDER; 4],
+            [Lod::PointMass; 4],
+            [PlanarState::default(); 4],
+            [LevelChoice::default(); 4],
+        );
+        let tables: Vec<_> = (creatures.iter().zip(lens))
+            .map(|(c, len)| (&entities[..len], &c[..], &lods[..len], &states[..len], &choices[..len]))
+            .collect();
+        let tables = Tables {
+            starts: vec![0, 3, 3, 5, 9],
+            tables,
+        };
+        assert_eq!(tables.len(), 9);
+        for from in 0..=9 {
+            for to in from..=9 {
+                let serials: Vec<u32> = tables.rows(from, to).map(|r| r.1.serial).collect();
+                assert_eq!(serials, (from as u32..to as u32).collect::<Vec<_>>(), "{from}..{to}");
+            }
+        }
+        assert_eq!(tables.row(5).1.serial, 5);
     }
 
     fn floors_of(crowd: &[Candidate]) -> Floors {
