@@ -1487,15 +1487,30 @@ fn decide(
         let (hull, made, tables) = (&hull, &made, &tables);
         move || {
             let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, (floors, _))| floors.len()).sum());
-            for (first, (floors, (bounds, settled_now))) in blocks {
-                let rows = tables.rows(first as usize, first as usize + floors.len());
-                let creatures = rows.zip(floors.iter().zip(bounds.iter_mut().zip(settled_now)));
-                for ((row, (&floor, (bound, settled))), i) in creatures.zip(first..) {
-                    let (entity, c, _, s, _) = row;
-                    *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
-                    let candidate = made(row, floor, bound);
-                    *settled = candidate.settled;
-                    candidate.list_hull(i, hull, &candidate.priced(hull.hysteresis), &mut listing);
+            for (first, (mut floors, (mut bounds, mut settled_now))) in blocks {
+                let mut i = first;
+                // A table's part at a time: its slices side by side with the block's.
+                for (entity, c, lod, s, choice) in tables.parts(first as usize, first as usize + floors.len()) {
+                    let n = entity.len();
+                    let (floors_here, bounds_here, settled_here);
+                    (
+                        (floors_here, floors),
+                        (bounds_here, bounds),
+                        (settled_here, settled_now),
+                    ) = (
+                        floors.split_at(n),
+                        std::mem::take(&mut bounds).split_at_mut(n),
+                        std::mem::take(&mut settled_now).split_at_mut(n),
+                    );
+                    let rows = (entity.iter().zip(c).zip(lod)).zip(s.iter().zip(choice));
+                    let creatures = rows.zip(floors_here.iter().zip(bounds_here.iter_mut().zip(settled_here)));
+                    for ((((&entity, c), lod), (s, choice)), (&floor, (bound, settled))) in creatures {
+                        *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
+                        let candidate = made((entity, c, lod, s, choice), floor, bound);
+                        *settled = candidate.settled;
+                        candidate.list_hull(i, hull, &candidate.priced(hull.hysteresis), &mut listing);
+                        i += 1;
+                    }
                 }
             }
             listing.finish();
@@ -1522,16 +1537,19 @@ fn decide(
 /// A creature as a decision reads it.
 type Row<'w> = (Entity, &'w Creature, &'w Lod, &'w PlanarState, &'w LevelChoice);
 
+/// Rows of one table, a slice of each component.
+type TableRows<'w> = (
+    &'w [Entity],
+    &'w [Creature],
+    &'w [Lod],
+    &'w [PlanarState],
+    &'w [LevelChoice],
+);
+
 /// A decision's creatures, read table by table where the query holds them: each core reads
 /// its own, where a row apiece gathered on one core first cost a pass over the crowd.
 struct Tables<'w> {
-    tables: Vec<(
-        &'w [Entity],
-        &'w [Creature],
-        &'w [Lod],
-        &'w [PlanarState],
-        &'w [LevelChoice],
-    )>,
+    tables: Vec<TableRows<'w>>,
     /// Where each table's rows start, then how many there are in all.
     starts: Vec<usize>,
 }
@@ -1552,16 +1570,33 @@ impl<'w> Tables<'w> {
         self.starts.last().copied().unwrap_or(0)
     }
 
-    /// The rows `from..to`, in the query's order.
-    fn rows(&self, from: usize, to: usize) -> impl Iterator<Item = Row<'w>> + '_ {
+    /// The rows `from..to`, in the query's order, as the parts of the tables they lie in.
+    fn parts(&self, from: usize, to: usize) -> impl Iterator<Item = TableRows<'w>> + '_ {
         // The last table starting at or before `from` holds it (an empty one never does).
         let first = self.starts.partition_point(|&s| s <= from).saturating_sub(1);
         (self.tables[first.min(self.tables.len())..]
             .iter()
             .zip(&self.starts[first..]))
-        .flat_map(move |(&(entity, c, lod, s, choice), &start)| {
+        .take_while(move |(_, start)| **start < to)
+        .map(move |(&(entity, c, lod, s, choice), &start)| {
             let (a, b) = (from.max(start) - start, to.min(start + entity.len()).max(start) - start);
-            (a..b.max(a)).map(move |j| (entity[j], &c[j], &lod[j], &s[j], &choice[j]))
+            let r = a..b.max(a);
+            (
+                &entity[r.clone()],
+                &c[r.clone()],
+                &lod[r.clone()],
+                &s[r.clone()],
+                &choice[r],
+            )
+        })
+    }
+
+    /// The rows `from..to`, in the query's order.
+    fn rows(&self, from: usize, to: usize) -> impl Iterator<Item = Row<'w>> + '_ {
+        self.parts(from, to).flat_map(|(entity, c, lod, s, choice)| {
+            (entity.iter().zip(c).zip(lod))
+                .zip(s.iter().zip(choice))
+                .map(|(((&e, c), l), (s, ch))| (e, c, l, s, ch))
         })
     }
 
