@@ -1331,7 +1331,7 @@ fn outweigh_times_s(rules: &BudgetRules, weight: f32) -> [f32; 2] {
 }
 
 /// One creature's benefits before its search for contacts with other creatures.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 struct Bounds {
     hybrid: f32,
     /// The rigid level's benefit from the view and the player.
@@ -1451,9 +1451,14 @@ fn decide(
         least_per_us: rules.least_benefit_per_ms / 1e3,
         settle_us: config.costs.contact_search_us,
     };
-    // A creature as the knapsack sees it, made from what this decision gathered of it: where
-    // its bounds are worked out, and again only for the few the queue comes back to.
-    let made = |(_, c, &lod, _, choice): Row, floor: Lod, bound: &Bounds| {
+    // A creature's benefits before its search, worked out again for the few the queue comes
+    // back to (the same bits: they depend on the creature and the scene alone) rather than kept
+    // for every creature.
+    let bounds_of = |(entity, c, _, s, _): Row| scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
+    // A creature as the knapsack sees it: made where its bounds are worked out, and again only
+    // for the few the queue comes back to.
+    let made = |row: Row, floor: Lod| {
+        let ((_, c, &lod, _, choice), bound) = (row, bounds_of(row));
         // A search within `contact_recheck_s` stands; without one, any contact with another
         // creature could be now.
         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
@@ -1472,13 +1477,11 @@ fn decide(
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
     // the cores a block at a time in turn: what one costs here depends on where it is (in view
     // or not), and the query keeps neighbours together, so that halves of it would not balance.
-    let mut bounds = vec![Bounds::default(); count];
     let mut settled_now = vec![false; count];
     let threads = count.div_ceil(chunk_len(config.scenario.creature_count(), count));
     let dear_us = floors.dear_us(room_us);
     let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
-    let blocks = (floors.levels.chunks(DEALT_BLOCK))
-        .zip(bounds.chunks_mut(DEALT_BLOCK).zip(settled_now.chunks_mut(DEALT_BLOCK)));
+    let blocks = (floors.levels.chunks(DEALT_BLOCK)).zip(settled_now.chunks_mut(DEALT_BLOCK));
     for (b, block) in blocks.enumerate() {
         dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
     }
@@ -1487,26 +1490,19 @@ fn decide(
         let (hull, made, tables) = (&hull, &made, &tables);
         move || {
             let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, (floors, _))| floors.len()).sum());
-            for (first, (mut floors, (mut bounds, mut settled_now))) in blocks {
+            for (first, (mut floors, mut settled_now)) in blocks {
                 let mut i = first;
                 // A table's part at a time: its slices side by side with the block's.
                 for (entity, c, lod, s, choice) in tables.parts(first as usize, first as usize + floors.len()) {
                     let n = entity.len();
-                    let (floors_here, bounds_here, settled_here);
-                    (
-                        (floors_here, floors),
-                        (bounds_here, bounds),
-                        (settled_here, settled_now),
-                    ) = (
-                        floors.split_at(n),
-                        std::mem::take(&mut bounds).split_at_mut(n),
-                        std::mem::take(&mut settled_now).split_at_mut(n),
-                    );
+                    let (floors_here, settled_here);
+                    ((floors_here, floors), (settled_here, settled_now)) =
+                        (floors.split_at(n), std::mem::take(&mut settled_now).split_at_mut(n));
                     let rows = (entity.iter().zip(c).zip(lod)).zip(s.iter().zip(choice));
-                    let creatures = rows.zip(floors_here.iter().zip(bounds_here.iter_mut().zip(settled_here)));
-                    for ((((&entity, c), lod), (s, choice)), (&floor, (bound, settled))) in creatures {
-                        *bound = scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
-                        let candidate = made((entity, c, lod, s, choice), floor, bound);
+                    for ((((&entity, c), lod), (s, choice)), (&floor, settled)) in
+                        rows.zip(floors_here.iter().zip(settled_here))
+                    {
+                        let candidate = made((entity, c, lod, s, choice), floor);
                         *settled = candidate.settled;
                         candidate.list_hull(i, hull, &candidate.priced(hull.hysteresis), &mut listing);
                         i += 1;
@@ -1520,14 +1516,14 @@ fn decide(
     let listed = Listing::merge(chunks.into_iter().flatten().collect());
     let floor_levels = floors.levels.clone();
     let mut crowd = Gathered {
-        made: |i: usize| made(tables.row(i), floor_levels[i], &bounds[i]),
+        made: |i: usize| made(tables.row(i), floor_levels[i]),
         settled: Default::default(),
     };
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut crowd, floors, settled_now, listed, room_us, &hull, |i| {
-        let (_, c, _, s, _) = tables.row(i);
+        let row @ (_, c, _, s, _) = tables.row(i);
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
-        (bounds[i].rigid(scene, urgency), urgency)
+        (bounds_of(row).rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
     allocation.predicted_us += config.costs.overhead_us(count);
