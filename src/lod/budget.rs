@@ -357,7 +357,7 @@ fn list_and_allocate<S: Send>(
     let mut floors = Floors::with_capacity(candidates.len());
     candidates.iter().for_each(|c| floors.add(c.into()));
     let dear_us = dear_us.unwrap_or_else(|| floors.dear_us(budget_us));
-    let listed = hull.list(candidates, 0, dear_us);
+    let listed = hull.list(candidates, dear_us);
     let settled_now = candidates.iter().map(|c| c.settled).collect();
     allocate_listed(candidates, floors, settled_now, listed, budget_us, hull, settle)
 }
@@ -580,12 +580,11 @@ struct Hull {
 }
 
 impl Hull {
-    /// Every step up the hulls of `candidates` (the first of them the `first` creature), a
-    /// creature's steps in turn, the cheap ones sorted ([`Listing`]). A chunk of the creatures
-    /// can be listed apart and the chunks merged ([`Listing::merge`]).
-    fn list(&self, candidates: &[Candidate], first: u32, dear_us: f32) -> Listing {
+    /// Every step up the hulls of `candidates`, a creature's steps in turn, the cheap ones
+    /// sorted ([`Listing`]).
+    fn list(&self, candidates: &[Candidate], dear_us: f32) -> Listing {
         let mut listed = Listing::new(dear_us, candidates.len());
-        for (i, c) in (first..).zip(candidates) {
+        for (i, c) in (0..).zip(candidates) {
             c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
         }
         listed.finish();
@@ -1998,7 +1997,7 @@ mod tests {
             least_per_us: 0.0,
             settle_us: 0.0,
         };
-        let listing = hull.list(&crowd, 0, 1.0);
+        let listing = hull.list(&crowd, 1.0);
         assert_eq!(listing.dear.len(), 1);
         let (_, dear) = &listing.dear[0];
         assert_eq!(dear.steps.len(), crowd.len());
@@ -2029,7 +2028,7 @@ mod tests {
             // Room for a few steps to rigid (and with the least, for a few hybrid ones), to many.
             for room_us in [50.0, 500.0, 5000.0, 50_000.0] {
                 let budget_us = floors.cost_us + room_us;
-                let listing = hull.list(crowd, 0, floors.dear_us(budget_us));
+                let listing = hull.list(crowd, floors.dear_us(budget_us));
                 assert!(listing.dear.iter().any(|(_, dear)| dear.steps.len() > 300));
                 let lazy = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
                 let sorted = list_and_allocate(&mut crowd.clone(), budget_us, &hull, Some(f32::INFINITY), |i| {
