@@ -25,10 +25,11 @@ pub struct CostModel {
     /// taken from the budget with the fixed cost. A file without it predicts 0.
     #[serde(default)]
     pub decision_us_per_creature: f32,
-    /// What the choice costs per creature where not one step up fits beside the creatures'
-    /// floors, in microseconds: a pass over the crowd that gives each its floor, no benefit
-    /// worked out. Charged then in place of `decision_us_per_creature`. A file without it
-    /// predicts 0.
+    /// What the budget policy costs per creature where not one step up fits beside the
+    /// creatures' floors, in microseconds: a pass over the crowd that gives each its floor, no
+    /// benefit worked out, and the writing of the levels and the switch stage's passes that a
+    /// fixed policy does without. Charged then in place of `decision_us_per_creature`. A file
+    /// without it predicts 0.
     #[serde(default)]
     pub floors_only_us_per_creature: f32,
     /// What the choice's search for one creature's soonest contact with another costs, in
