@@ -385,7 +385,7 @@ fn a_search_for_contacts_with_other_creatures_stands_for_the_recheck_time_and_is
 }
 
 #[test]
-fn a_budget_cut_below_the_cheapest_levels_keeps_each_creature_in_its_dwell_at_its_level() {
+fn a_budget_cut_below_the_cheapest_levels_sends_the_rigid_to_their_floors_and_holds_the_rest() {
     // Room for a few rigid creatures: the levels move.
     let mut sim = HeadlessSim::new(budget_scene(30, 0.5));
     let min_dwell_s = sim.app.world().resource::<SimConfig>().rules.min_dwell_s;
@@ -418,7 +418,10 @@ fn a_budget_cut_below_the_cheapest_levels_keeps_each_creature_in_its_dwell_at_it
     }
     assert!(!dwelling.is_empty(), "no creature went above the point mass");
     let before = levels(&mut sim);
-    // Now not one step up fits beside the floors: the choice gives the floors at once.
+    let hybrids = |rows: &[(u32, Lod, LevelChoice, f32)]| rows.iter().filter(|r| r.1 == Lod::Hybrid).count();
+    assert!(hybrids(&before) > 0, "no hybrid to hold");
+    // Now not one step up fits beside the floors: the choice gives them at once, but a
+    // creature below the rigid level keeps its level (its switch would cost more than it saves).
     sim.app
         .world_mut()
         .resource_mut::<SimConfig>()
@@ -427,7 +430,7 @@ fn a_budget_cut_below_the_cheapest_levels_keeps_each_creature_in_its_dwell_at_it
         .frame_budget_ms = 0.001;
     sim.advance_frame();
     for ((serial, level, ..), (_, _, choice, _)) in before.iter().zip(levels(&mut sim)) {
-        let floor = if dwelling.contains(serial) {
+        let floor = if dwelling.contains(serial) || *level < Lod::Rigid {
             *level
         } else {
             Lod::PointMass
@@ -436,11 +439,13 @@ fn a_budget_cut_below_the_cheapest_levels_keeps_each_creature_in_its_dwell_at_it
     }
     let tally = sim.app.world().resource::<BudgetTally>().clone();
     assert!(tally.over_budget > 0 && tally.model_us > 100.0, "{tally:?}");
-    // Once the dwell is over, every creature wants the point mass.
+    // Once the dwell is over, no creature wants the rigid level, and the hybrids are held.
     sim.run_for(f64::from(min_dwell_s) + 0.2);
-    assert!(
-        levels(&mut sim)
-            .iter()
-            .all(|(_, _, choice, _)| choice.wanted == Lod::PointMass)
-    );
+    let after = levels(&mut sim);
+    assert!(after.iter().all(|(_, _, choice, _)| choice.wanted != Lod::Rigid));
+    for ((serial, level, ..), (_, _, choice, _)) in before.iter().zip(&after) {
+        if *level == Lod::Hybrid {
+            assert_eq!(choice.wanted, Lod::Hybrid, "creature {serial}");
+        }
+    }
 }
