@@ -573,7 +573,7 @@ fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
 fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys_more_with_more() {
     let dir = scratch_dir("budget_scale");
     let file = dir.join("budget_scale.ron");
-    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], seconds: 0.3, seed: 3)";
+    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], seconds: 0.4, warm_up_s: 0.1, seed: 3)";
     std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
     let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
     every_file_it_says_it_wrote_exists(&said, &dir);
@@ -591,6 +591,12 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         }
     }
     assert_eq!(games, want);
+    // Each game's figures are of its frames after the warm-up; the warm-up's slowest is apart.
+    for r in &rows[1..] {
+        assert_eq!(r[3], "9", "{r:?}");
+        assert!(r[11].parse::<f64>().unwrap() > 0.0, "{r:?}");
+    }
+    assert!(said.contains("The first 0.1 s of each game"), "{said}");
     // The cost model alone is reproducible: a larger budget buys more rigid creatures.
     let rigid = |n: &str, b: &str| {
         let r = rows.iter().find(|r| r[0] == n && r[1] == b && r[2] == "0").unwrap();
@@ -628,4 +634,15 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
     .unwrap();
     let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
     assert!(err.to_string().contains("creatures"), "{err}");
+    // So is a warm-up as long as the game.
+    std::fs::write(
+        &file,
+        format!(
+            "(full: {0}, quick: {0})",
+            settings.replace("warm_up_s: 0.1", "warm_up_s: 0.4")
+        ),
+    )
+    .unwrap();
+    let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
+    assert!(err.to_string().contains("warm_up_s"), "{err}");
 }

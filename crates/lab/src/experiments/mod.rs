@@ -173,14 +173,20 @@ pub fn hold_levels(sim: &mut HeadlessSim, stages: &[SimStage]) {
 /// Runs `config` for `seconds` (whole frames of one steering decision), timing each frame.
 pub fn timed_game(config: SimConfig, seconds: f64) -> (Vec<f64>, Summary) {
     let mut sim = HeadlessSim::new(config);
+    let frames = timed_frames(&mut sim, seconds);
+    let wall = frames.iter().sum();
+    (frames, sim.summary(wall))
+}
+
+/// Each frame of `sim` until its clock reaches `seconds`, in seconds of wall time.
+pub fn timed_frames(sim: &mut HeadlessSim, seconds: f64) -> Vec<f64> {
     let mut frames = Vec::new();
     while sim.clock().seconds() < seconds - 1e-9 {
         let start = Instant::now();
         sim.advance_frame();
         frames.push(start.elapsed().as_secs_f64());
     }
-    let wall = frames.iter().sum();
-    (frames, sim.summary(wall))
+    frames
 }
 
 /// Runs `work` on every item on `jobs` threads and hands each result to `done` on this
