@@ -243,12 +243,16 @@ fn steer(
             }
             (desired.0, *clear) = desired_velocity(creature, state, kind, &around);
         };
-    for (creature, state, lod, mut desired, mut clear) in creatures.contiguous_iter_mut().expect(DENSE) {
+    // Every table's chunks in one scope: a scope a table cost a world of mixed levels (a table
+    // for each) more than the tables' steering.
+    let mut tables: Vec<_> = creatures.contiguous_iter_mut().expect(DENSE).collect();
+    let mut jobs = Vec::new();
+    for (creature, state, lod, desired, clear) in &mut tables {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         let (desired, clear) = (desired.bypass_change_detection(), clear.bypass_change_detection());
         let chunks = (creature.chunks(n).zip(state.chunks(n)).zip(lod.chunks(n)))
             .zip(desired.chunks_mut(n).zip(clear.chunks_mut(n)));
-        run_chunks(chunks.map(|(((c, s), l), (d, cl))| {
+        jobs.extend(chunks.map(|(((c, s), l), (d, cl))| {
             move || {
                 for (((c, s), l), (d, cl)) in c.iter().zip(s).zip(l).zip(d.iter_mut().zip(cl)) {
                     steer_one(c, s, *l, d, cl);
@@ -256,6 +260,7 @@ fn steer(
             }
         }));
     }
+    run_chunks(jobs.into_iter());
 }
 
 pub(super) fn plugin(app: &mut App) {

@@ -423,9 +423,10 @@ pub(crate) fn step_point_masses(
     let (stepper, follow) = (&stepper, &follow);
     // Whole columns of components, run in one tight loop per thread: every tick, Bevy's fetch
     // of each creature's components one by one cost more than the step itself.
-    for ((creature, lod, desired), (mut state, mut gait, mut pose), (mut frame, mut segment)) in
-        creatures.contiguous_iter_mut().expect(DENSE)
-    {
+    // Every table's chunks in one scope (see `steer`).
+    let mut tables: Vec<_> = creatures.contiguous_iter_mut().expect(DENSE).collect();
+    let mut jobs = Vec::new();
+    for ((creature, lod, desired), (state, gait, pose), (frame, segment)) in &mut tables {
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         // Nothing watches these components' change ticks: writing them is a pass of its own.
         let (state, gait) = (state.bypass_change_detection(), gait.bypass_change_detection());
@@ -434,7 +435,7 @@ pub(crate) fn step_point_masses(
         let chunks = (creature.chunks(n).zip(lod.chunks(n)).zip(desired.chunks(n)))
             .zip((state.chunks_mut(n).zip(gait.chunks_mut(n))).zip(pose.chunks_mut(n)))
             .zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)));
-        run_chunks(chunks.map(|((((c, l), d), ((s, g), p)), (f, seg))| {
+        jobs.extend(chunks.map(|((((c, l), d), ((s, g), p)), (f, seg))| {
             move || {
                 if !last_of_frame {
                     // Only the creatures not behind move: found by a scan of their flags alone,
@@ -482,6 +483,7 @@ pub(crate) fn step_point_masses(
             }
         }));
     }
+    run_chunks(jobs.into_iter());
 }
 
 /// Creatures a catch-up moves on the plane before it moves their gaits: a few lines of the

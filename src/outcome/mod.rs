@@ -238,18 +238,19 @@ fn plan_frames(
             && clearance.clear_of_creatures(kind, widest_m, speed, clock.dt)
             && !could_reach_puck_or_wall(state, record, kind, &puck, puck_reach_m, court.half_extents, frame_s);
     };
-    for ((creature, state, record, clearance, lod, choice, probed, player), mut frame) in
-        creatures.contiguous_iter_mut().expect(DENSE)
-    {
+    // Every table's chunks in one scope (see `steer`).
+    let mut tables: Vec<_> = creatures.contiguous_iter_mut().expect(DENSE).collect();
+    let mut jobs = Vec::new();
+    for ((creature, state, record, clearance, lod, choice, probed, player), frame) in &mut tables {
         let frame = frame.bypass_change_detection();
-        if probed || player {
+        if *probed || *player {
             frame.iter_mut().for_each(|f| f.behind = false);
             continue;
         }
         let n = chunk_len(config.scenario.creature_count(), creature.len());
         let chunks = (creature.chunks(n).zip(state.chunks(n)).zip(record.chunks(n)))
             .zip((clearance.chunks(n).zip(lod.chunks(n)).zip(choice.chunks(n))).zip(frame.chunks_mut(n)));
-        run_chunks(chunks.map(|(((c, s), r), (((cl, l), ch), f))| {
+        jobs.extend(chunks.map(|(((c, s), r), (((cl, l), ch), f))| {
             move || {
                 let rows = (c.iter().zip(s).zip(r)).zip((cl.iter().zip(l).zip(ch)).zip(f));
                 for (((c, s), r), (((cl, l), ch), f)) in rows {
@@ -258,6 +259,8 @@ fn plan_frames(
             }
         }));
     }
+    run_chunks(jobs.into_iter());
+    drop(tables);
     if let Some((_, mut frame)) = camera.following.and_then(|e| creatures.get_mut(e).ok()) {
         frame.behind = false;
     }
@@ -371,16 +374,13 @@ fn detect_collisions(
     };
     // Nothing watches these components' change ticks: the loops leave them alone (writing
     // them is a pass over a column of its own).
-    for (
-        entity,
-        creature,
-        mut state,
-        mut record,
-        clearance,
-        player,
-        (lod, desired, mut gait, mut pose, (mut frame, mut segment)),
-    ) in creatures.contiguous_iter_mut().expect(DENSE)
+    // Every table's chunks in one scope (see `steer`).
+    let mut tables: Vec<_> = creatures.contiguous_iter_mut().expect(DENSE).collect();
+    let mut jobs = Vec::new();
+    for (entity, creature, state, record, clearance, player, (lod, desired, gait, pose, (frame, segment))) in
+        &mut tables
     {
+        let player = *player;
         let n = chunk_len(config.scenario.creature_count(), entity.len());
         let (state, record) = (state.bypass_change_detection(), record.bypass_change_detection());
         let (gait, pose, frame) = (
@@ -395,7 +395,7 @@ fn detect_collisions(
             (lod.chunks(n).zip(desired.chunks(n)))
                 .zip((gait.chunks_mut(n).zip(pose.chunks_mut(n))).zip(frame.chunks_mut(n).zip(segment.chunks_mut(n)))),
         );
-        run_chunks(chunks.map(|((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg))))| {
+        jobs.extend(chunks.map(|((((e, c), cl), (s, r)), ((l, d), ((g, p), (f, seg))))| {
             move || {
                 // A creature behind its frame is passed by unless the puck outran its reach: the
                 // others are found by a scan of the flags alone (in a crowd nearly all are behind).
@@ -416,6 +416,8 @@ fn detect_collisions(
             }
         }));
     }
+    run_chunks(jobs.into_iter());
+    drop(tables);
     if decision {
         switched.clear();
         let watch = &mut *watch;
