@@ -224,8 +224,8 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
         650,
         &[Panel {
             title: format!(
-                "the budget policy's mean frame against its budget: games of {} s",
-                s.seconds
+                "the budget policy's mean frame against its budget: games of {} s, the first {} s left out",
+                s.seconds, s.warm_up_s
             ),
             x_label: "creatures, log10 (2 is 100, 5 is 100,000)".into(),
             y_label: "mean frame over the budget (log)".into(),
@@ -239,9 +239,8 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
 }
 
 fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
-    // The frames a game holds, and which of them, slowest first, is its 99th percentile: the
-    // slowest of all in a game under 100 frames (where a game's first frame, which builds the
-    // world's bodies, usually is).
+    // The frames a game holds after its warm-up, and which of them, slowest first, is its 99th
+    // percentile: the slowest of all in a game under 100 frames.
     let frames = games.first().map_or(0, |g| g.frames);
     let p99_is = match frames - (frames as f64 * 0.99).ceil() as usize {
         0 => "its slowest frame".to_owned(),
