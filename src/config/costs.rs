@@ -21,8 +21,10 @@ pub struct CostModel {
     #[serde(default)]
     pub fixed_us_per_frame: f32,
     /// What the budget policy's own choice costs per creature per 1/30 s (its benefits short
-    /// of the search for contacts with other creatures, and the knapsack), in microseconds:
-    /// taken from the budget with the fixed cost. A file without it predicts 0.
+    /// of the search for contacts with other creatures, and the knapsack), in microseconds, as
+    /// it plays: with the writing of the levels, the switch stage's passes and the switches
+    /// between the cheaper levels, in a world of a table for each level. Taken from the budget
+    /// with the fixed cost. A file without it predicts 0.
     #[serde(default)]
     pub decision_us_per_creature: f32,
     /// What the budget policy costs per creature where not one step up fits beside the
@@ -50,6 +52,28 @@ pub struct CostModel {
     /// every crowd.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub larger_crowd_shares: Vec<CrowdShares>,
+    /// What the rigid level costs per creature in play among as many rigid creatures as each
+    /// entry counts (those the budget picks: about to touch something, or in view), as a share
+    /// of the figures above (measured in open court among a few tens of one kind). Rapier works
+    /// through its contacts across the cores once it has more than 64 to update, so that a
+    /// rigid creature among one or two hundred costs about two thirds of one among ten; among
+    /// more, its work per body grows again. Smallest count first: a count between two measured
+    /// takes a share between theirs on the logarithm of the count; one short of the smallest,
+    /// or beyond the largest, takes its share. A file without them predicts any count at the
+    /// figures.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rigid_shares: Vec<RigidShare>,
+}
+
+/// The rigid level's cost per creature among `rigid` rigid creatures, as a share of its
+/// figure; 0.01 to 10.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RigidShare {
+    /// The rigid creatures it was measured among, 1 or more.
+    pub rigid: u32,
+    /// Of the rigid level's cost.
+    pub share: f32,
 }
 
 /// The cheap levels' cost per creature in a crowd of [`PARALLEL_MIN_CREATURES`] or more, as
@@ -161,15 +185,34 @@ impl CostModel {
         self.fixed_us_per_frame + per_creature_us * share * creatures as f32
     }
 
-    /// The costs of the kind named `kind` in a world of `creatures`: in a crowd, the cheap
-    /// levels at their crowd shares.
-    pub fn in_crowd(&self, kind: &str, creatures: u32) -> LevelCosts {
+    /// The costs of the kind named `kind` in a world of `creatures`, `rigid` of them rigid: in
+    /// a crowd, the cheap levels at their crowd shares; the rigid level at its share among
+    /// that many.
+    pub fn in_crowd(&self, kind: &str, creatures: u32, rigid: u32) -> LevelCosts {
         let mut costs = *self.of(kind);
         if let Some(shares) = self.shares_in_crowd(creatures) {
             costs.point_mass_us_per_frame *= shares.point_mass;
             costs.hybrid_us_per_frame *= shares.hybrid;
         }
+        costs.rigid_us_per_frame *= self.rigid_share(rigid);
         costs
+    }
+
+    /// The rigid level's share of its cost among `rigid` rigid creatures (see
+    /// `rigid_shares`): 1 without any measured.
+    pub fn rigid_share(&self, rigid: u32) -> f32 {
+        let Some(first) = self.rigid_shares.first() else {
+            return 1.0;
+        };
+        let mut below = first;
+        for above in &self.rigid_shares {
+            if above.rigid >= rigid {
+                let t = along_log(rigid, below.rigid, above.rigid);
+                return below.share + (above.share - below.share) * t;
+            }
+            below = above;
+        }
+        below.share
     }
 
     /// The cheap levels' and the choice's shares in a world of `creatures` (see
@@ -180,12 +223,7 @@ impl CostModel {
         let (mut below, n) = (first, creatures as f32);
         for above in measured {
             if above.creatures as f32 >= n {
-                let (lo, hi) = ((below.creatures as f32).ln(), (above.creatures as f32).ln());
-                let t = if hi > lo {
-                    ((n.ln() - lo) / (hi - lo)).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
+                let t = along_log(creatures, below.creatures, above.creatures);
                 let at = |b: f32, a: f32| b + (a - b) * t;
                 return Some(CrowdShares {
                     creatures,
@@ -206,6 +244,17 @@ impl CostModel {
             .iter()
             .find(|k| k.kind == kind)
             .map_or(&self.other_kinds, |k| &k.costs)
+    }
+}
+
+/// How far `n` lies from `lo` to `hi` on the logarithm of the count, 0 to 1 (1 where they are
+/// the same).
+fn along_log(n: u32, lo: u32, hi: u32) -> f32 {
+    let (n, lo, hi) = ((n.max(1) as f32).ln(), (lo as f32).ln(), (hi as f32).ln());
+    if hi > lo {
+        ((n - lo) / (hi - lo)).clamp(0.0, 1.0)
+    } else {
+        1.0
     }
 }
 
@@ -269,6 +318,21 @@ impl Validate for CostModel {
             });
             before = larger.creatures;
         }
+        let mut fewer = 0;
+        for (i, r) in self.rigid_shares.iter().enumerate() {
+            v.nested(&format!("rigid_shares[{i}]"), |v| {
+                v.require(
+                    r.rigid > fewer,
+                    "rigid",
+                    format!(
+                        "must be more than {fewer} (more than the count before), got {}",
+                        r.rigid
+                    ),
+                );
+                v.within("share", r.share, 0.01, 10.0);
+            });
+            fewer = r.rigid;
+        }
     }
 }
 
@@ -296,8 +360,8 @@ mod tests {
         let text = format!("(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((point_mass: 0.5, hybrid: 0.25)))");
         let model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
         let (few, crowd) = (
-            model.in_crowd("hopper", PARALLEL_MIN_CREATURES - 1),
-            model.in_crowd("hopper", PARALLEL_MIN_CREATURES),
+            model.in_crowd("hopper", PARALLEL_MIN_CREATURES - 1, 0),
+            model.in_crowd("hopper", PARALLEL_MIN_CREATURES, 0),
         );
         assert_eq!((few.point_mass_us_per_frame, few.hybrid_us_per_frame), (1.0, 2.0));
         assert_eq!((crowd.point_mass_us_per_frame, crowd.hybrid_us_per_frame), (0.5, 0.5));
@@ -308,7 +372,7 @@ mod tests {
             Path::new("costs.ron"),
         )
         .unwrap();
-        assert_eq!(plain.in_crowd("hopper", 1_000_000), *plain.of("hopper"));
+        assert_eq!(plain.in_crowd("hopper", 1_000_000, 0), *plain.of("hopper"));
         let bad = text.replace("0.25", "0");
         let err = parse_ron::<CostModel>(bad.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`crowd_shares.hybrid`"), "{err}");
@@ -336,7 +400,7 @@ mod tests {
         assert_eq!(model.floors_only_overhead_us(100), 25.0);
         assert_eq!(model.floors_only_overhead_us(1_000_000), 2.0 * 0.25 * 1e6);
         assert_eq!(model.floors_only_overhead_us(16_384), 0.25 * 16_384.0);
-        let point_mass = |n| model.in_crowd("hopper", n).point_mass_us_per_frame;
+        let point_mass = |n| model.in_crowd("hopper", n, 0).point_mass_us_per_frame;
         // The smallest crowd's share down to the smallest crowd, the largest's beyond it.
         assert_eq!(point_mass(PARALLEL_MIN_CREATURES), 1.0);
         assert_eq!(point_mass(4096), 1.0);
@@ -345,7 +409,7 @@ mod tests {
         assert!((point_mass(8192) - 0.75).abs() < 1e-5, "{}", point_mass(8192));
         assert!((point_mass(32_768) - 0.375).abs() < 1e-5, "{}", point_mass(32_768));
         assert_eq!(point_mass(16_384), 0.5);
-        assert!((model.in_crowd("hopper", 8192).hybrid_us_per_frame - 1.75).abs() < 1e-5);
+        assert!((model.in_crowd("hopper", 8192, 0).hybrid_us_per_frame - 1.75).abs() < 1e-5);
         // A file of one share, from before the counts: measured at 16,384, for every crowd.
         let old: CostModel = parse_ron(
             format!("(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((point_mass: 0.5, hybrid: 0.5)))").as_bytes(),
@@ -353,8 +417,8 @@ mod tests {
         )
         .unwrap();
         assert_eq!(old.crowd_shares.unwrap().creatures, 16_384);
-        assert_eq!(old.in_crowd("hopper", 3000).point_mass_us_per_frame, 0.5);
-        assert_eq!(old.in_crowd("hopper", 1_000_000).point_mass_us_per_frame, 0.5);
+        assert_eq!(old.in_crowd("hopper", 3000, 0).point_mass_us_per_frame, 0.5);
+        assert_eq!(old.in_crowd("hopper", 1_000_000, 0).point_mass_us_per_frame, 0.5);
         // Counts out of order are refused, and named.
         let unordered = text.replace("creatures: 65536", "creatures: 8192");
         let err = parse_ron::<CostModel>(unordered.as_bytes(), Path::new("costs.ron")).unwrap_err();
@@ -368,5 +432,39 @@ mod tests {
         let last = text.replace("creatures: 4096", &format!("creatures: {}", u32::MAX));
         let err = parse_ron::<CostModel>(last.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`larger_crowd_shares[0].creatures`"), "{err}");
+    }
+
+    #[test]
+    fn the_rigid_level_costs_its_share_at_the_count_of_rigid_creatures_between_two_measured() {
+        let text = format!(
+            "(kinds: [], other_kinds: {COSTS}, rigid_shares: [(rigid: 10, share: 1.2), (rigid: 160, share: 0.6), (rigid: 640, share: 0.9)])"
+        );
+        let model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
+        let rigid = |n| model.in_crowd("hopper", 40, n).rigid_us_per_frame;
+        // The smallest count's share below it, the largest's beyond it; the cheap levels
+        // untouched.
+        assert!((rigid(0) - 120.0).abs() < 1e-3, "{}", rigid(0));
+        assert!((rigid(10) - 120.0).abs() < 1e-3, "{}", rigid(10));
+        assert!((rigid(10_000) - 90.0).abs() < 1e-3, "{}", rigid(10_000));
+        assert_eq!(model.in_crowd("hopper", 40, 160).hybrid_us_per_frame, 2.0);
+        // Halfway on the logarithm: 40 between 10 and 160, 320 between 160 and 640.
+        assert!((rigid(40) - 90.0).abs() < 1e-3, "{}", rigid(40));
+        assert!((rigid(320) - 75.0).abs() < 1e-3, "{}", rigid(320));
+        // A file without them prices every count at the figure.
+        let plain: CostModel = parse_ron(
+            format!("(kinds: [], other_kinds: {COSTS})").as_bytes(),
+            Path::new("costs.ron"),
+        )
+        .unwrap();
+        assert_eq!(plain.in_crowd("hopper", 40, 500).rigid_us_per_frame, 100.0);
+        // Counts out of order, and shares out of range, are refused and named.
+        for (bad, field) in [
+            (text.replace("rigid: 640", "rigid: 160"), "`rigid_shares[2].rigid`"),
+            (text.replace("rigid: 10,", "rigid: 0,"), "`rigid_shares[0].rigid`"),
+            (text.replace("share: 0.6", "share: 0"), "`rigid_shares[1].share`"),
+        ] {
+            let err = parse_ron::<CostModel>(bad.as_bytes(), Path::new("costs.ron")).unwrap_err();
+            assert!(err.to_string().contains(field), "{err}");
+        }
     }
 }

@@ -17,7 +17,7 @@ mod validate;
 
 pub use crate::contract::MAX_LEGS;
 pub use arena::{ArenaConfig, PuckConfig};
-pub use costs::{CostModel, CrowdShares, KindCosts, LevelCosts};
+pub use costs::{CostModel, CrowdShares, KindCosts, LevelCosts, RigidShare};
 pub use creature::{
     BodyConfig, CreatureDef, FallConfig, KindLook, LegConfig, RaibertConfig, RigidConfig, RigidJoints, Stance,
     SteeringConfig,
@@ -65,12 +65,13 @@ pub struct MeasuredAnew<'a> {
 }
 
 impl SimConfig {
-    /// What each of its kinds costs (in the kinds' order) in a world of its scenario's size.
-    pub fn costs_by_kind(&self) -> Vec<LevelCosts> {
+    /// What each of its kinds costs (in the kinds' order) in a world of its scenario's size,
+    /// `rigid` of its creatures rigid.
+    pub fn costs_by_kind(&self, rigid: u32) -> Vec<LevelCosts> {
         let population = self.scenario.creature_count();
         self.kinds
             .iter()
-            .map(|k| self.costs.in_crowd(&k.name, population))
+            .map(|k| self.costs.in_crowd(&k.name, population, rigid))
             .collect()
     }
 

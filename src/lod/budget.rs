@@ -1424,7 +1424,15 @@ fn decide(
     creatures: &Creatures,
     budget_us: f32,
 ) -> Allocation<f32> {
-    let costs = config.costs_by_kind();
+    let readonly = creatures.as_readonly();
+    let tables = Tables::of(&readonly);
+    // The rigid level at its cost among the rigid creatures there are now.
+    let rigid = tables
+        .tables
+        .iter()
+        .map(|t| t.2.iter().filter(|&&l| l == Lod::Rigid).count())
+        .sum::<usize>();
+    let costs = config.costs_by_kind(rigid as u32);
     let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
         if dwelling { lod } else { kinds[c.kind].levels[0] }
@@ -1449,8 +1457,6 @@ fn decide(
             })
         })
         .collect();
-    let readonly = creatures.as_readonly();
-    let tables = Tables::of(&readonly);
     let count = tables.len();
     let mut floors = Floors::with_capacity(count);
     for (_, c, &lod, _, choice) in tables.rows(0, count) {

@@ -196,12 +196,18 @@ fn count_levels(
     if !clock.is_decision_tick() {
         return;
     }
-    let costs = config.costs_by_kind();
     let mut counts: Counts<Lod, u64> = Counts::default();
-    let mut frame_us = f64::from(config.costs.fixed_us_per_frame);
+    let mut per_kind = vec![Counts::<Lod, u64>::default(); config.kinds.len()];
     for (&lod, c) in &levels {
         counts[lod] += 1;
-        frame_us += f64::from(costs[c.kind].per_frame_us(lod));
+        per_kind[c.kind][lod] += 1;
+    }
+    let costs = config.costs_by_kind(counts[Lod::Rigid] as u32);
+    let mut frame_us = f64::from(config.costs.fixed_us_per_frame);
+    for (costs, n) in costs.iter().zip(&per_kind) {
+        for (lod, n) in n.iter() {
+            frame_us += f64::from(costs.per_frame_us(lod)) * n as f64;
+        }
     }
     tally.samples += 1;
     tally.predicted_frame_sum_us += frame_us;

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 
 use crate::support::*;
 use simlod::arena::PuckState;
-use simlod::config::{CostModel, LevelCosts, SimConfig};
+use simlod::config::{CostModel, LevelCosts, RigidShare, SimConfig};
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
 use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
@@ -31,6 +31,7 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
         contact_search_us: 0.0,
         crowd_shares: None,
         larger_crowd_shares: Vec::new(),
+        rigid_shares: Vec::new(),
     };
     config.rules.budget.frame_budget_ms = budget_ms;
     config
@@ -96,6 +97,36 @@ fn every_policy_reports_its_frames_as_the_cost_model_predicts_them_from_the_leve
             "{policy:?}: {frame:?}"
         );
     }
+}
+
+#[test]
+fn the_rigid_level_is_priced_at_its_share_among_as_many_rigid_creatures_as_there_are() {
+    // 10 hoppers all rigid, a court costing 30 us, the rigid level at half its figure among
+    // 10 or more: 0.53 ms.
+    let shares = |share: f32| vec![RigidShare { rigid: 2, share: 1.0 }, RigidShare { rigid: 10, share }];
+    let mut config = budget_scene(10, 0.0);
+    (config.scenario.level_policy, config.costs.fixed_us_per_frame) = (LevelPolicy::AllRigid, 30.0);
+    config.costs.rigid_shares = shares(0.5);
+    let mut sim = HeadlessSim::new(config);
+    sim.run_for(2.0);
+    let frame = sim.summary(0.0).predicted_frame;
+    assert!((frame.mean_ms - 0.53).abs() < 1e-6, "{frame:?}");
+    // The budget buys at the same price: among 30 hoppers with room for some five rigid at
+    // the figure, more once they are rigid at a third of it among ten.
+    let rigid_on_average = |rigid_shares: Vec<RigidShare>| {
+        let mut config = budget_scene(30, 0.6);
+        config.costs.rigid_shares = rigid_shares;
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(10.0);
+        let summary = sim.summary(0.0);
+        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
+        summary.levels_mean[Lod::Rigid]
+    };
+    let (at_figure, cheaper) = (rigid_on_average(Vec::new()), rigid_on_average(shares(1.0 / 3.0)));
+    assert!(
+        cheaper > 1.5 * at_figure,
+        "{cheaper} rigid on average against {at_figure}"
+    );
 }
 
 #[test]

@@ -143,6 +143,9 @@ fn calibrating_writes_a_cost_model_that_loads_even_for_rules_whose_model_is_not_
     for k in &model.kinds {
         assert!(k.costs.rigid_us_per_frame > 10.0 * k.costs.hybrid_us_per_frame, "{k:?}");
     }
+    // The rigid level in play, among few rigid creatures and among many (the file loaded, so
+    // the counts rise).
+    assert_eq!(model.rigid_shares.len(), 2, "{model:?}");
 }
 
 fn refused(args: &[&str], says: &str) {

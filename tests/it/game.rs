@@ -496,7 +496,7 @@ fn the_costs_measured_at_start_up_stand_through_edits_of_the_rules_and_of_the_sc
 }
 
 #[test]
-fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares() {
+fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_and_rigid_shares() {
     let config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
     let measured = simlod_lab::bench::calibrate(&config, simlod_lab::bench::Calibration::AtStartUp);
     // Every kind of the scenario, a rigid creature far dearer than a hybrid one; the court
@@ -520,4 +520,7 @@ fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_shares
     assert!(config.costs.crowd_shares.is_some() && !config.costs.larger_crowd_shares.is_empty());
     assert_eq!(measured.crowd_shares, config.costs.crowd_shares);
     assert_eq!(measured.larger_crowd_shares, config.costs.larger_crowd_shares);
+    // Nor are hundreds of rigid creatures in play: the rigid level's shares are the file's.
+    assert!(!config.costs.rigid_shares.is_empty());
+    assert_eq!(measured.rigid_shares, config.costs.rigid_shares);
 }

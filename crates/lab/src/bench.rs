@@ -10,10 +10,11 @@ pub use crate::scene::scaled;
 use serde::Serialize;
 use std::time::Instant;
 
-use simlod::config::{CostModel, CrowdShares, KindCosts, LevelCosts, SimConfig};
+use simlod::config::{CostModel, CrowdShares, KindCosts, LevelCosts, RigidShare, SimConfig};
 use simlod::creature::KindTable;
 use simlod::headless::HeadlessSim;
-use simlod::lod::{LevelPolicy, Lod};
+use simlod::kind::Creature;
+use simlod::lod::{BudgetTally, LevelPolicy, Lod};
 
 /// Wall-clock budget of one frame at 30 fps.
 const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
@@ -292,9 +293,11 @@ pub enum Calibration {
 /// a court without creatures stepped beside it (see `median_extra_seconds`), divided
 /// by the creatures (fewer than [`simlod::PARALLEL_MIN_CREATURES`], so one thread, as in a
 /// game), and the switch into the rigid level (see `switch_cost_us`). A kind without an entry
-/// is predicted at the dearest calibrated kind's costs. Last, the budget policy's own choice
-/// (see `choice_cost_us`), and the cheap levels' cost per creature in a crowd stepped across
-/// the cores, as shares of their cost on one thread (at start-up, kept from `config.costs`).
+/// is predicted at the dearest calibrated kind's costs. Then the budget policy's own choice
+/// (see `choice_cost_us`, `choice_in_play_us`); last, the rigid level in play as shares of its
+/// figures by the count of rigid creatures (see `rigid_in_play`), and the cheap levels' cost
+/// per creature in a crowd stepped across the cores, as shares of their cost on one thread
+/// (both, at start-up, kept from `config.costs`).
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     // Whole passes over every figure, each figure the median of the passes': a pass takes a
     // few seconds, and this machine has slow spells as long (rigid creatures and the fixed
@@ -365,16 +368,40 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         contact_search_us: 0.0,
         crowd_shares: None,
         larger_crowd_shares: Vec::new(),
+        rigid_shares: Vec::new(),
     };
     let choice = choice_cost_us(config, &model, cheap_count, (warmup, frames), true);
-    model.decision_us_per_creature = choice.per_creature_us as f32;
     model.floors_only_us_per_creature = choice.floors_only_us as f32;
     model.contact_search_us = choice.search_us as f32;
+    model.decision_us_per_creature = choice_in_play_us(
+        config,
+        &model,
+        cheap_count,
+        choice.per_creature_us,
+        (warmup.max(30), frames),
+    ) as f32;
     if how == Calibration::AtStartUp {
         model.crowd_shares = config.costs.crowd_shares;
         model.larger_crowd_shares = config.costs.larger_crowd_shares.clone();
+        model.rigid_shares = config.costs.rigid_shares.clone();
         return model;
     }
+    // The rigid level in play, among ten rigid creatures and among hundreds (see
+    // `rigid_in_play`); the warm-up long enough for the budget's creatures to reach their
+    // levels. A count is at least one more than the one before, as the file requires.
+    let rigid_counts: &[u32] = match how {
+        Calibration::Quick => &[10, 100],
+        _ => &[10, 40, 160, 400, 800],
+    };
+    let mut fewer = 0;
+    model.rigid_shares = (rigid_counts.iter())
+        .map(|&rigid| {
+            let mut share = rigid_in_play(config, &model, rigid, (warmup.max(30), frames));
+            share.rigid = share.rigid.max(fewer + 1);
+            fewer = share.rigid;
+            share
+        })
+        .collect();
     // The cheap levels in crowds stepped across the cores: the scenario's mix at each crowd
     // size against the same below a crowd, per creature (a creature costs less the larger the
     // crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two thirds of it).
@@ -456,6 +483,12 @@ fn median_model(models: &[CostModel]) -> CostModel {
         larger_crowd_shares: (0..first.larger_crowd_shares.len())
             .map(|i| shares_of(&|m| &m.larger_crowd_shares[i]))
             .collect(),
+        rigid_shares: (0..first.rigid_shares.len())
+            .map(|i| RigidShare {
+                rigid: median_of(&|m| m.rigid_shares[i].rigid as f32) as u32,
+                share: median_of(&|m| m.rigid_shares[i].share),
+            })
+            .collect(),
     };
     model.other_kinds = dearest(&model.kinds);
     model
@@ -529,6 +562,121 @@ fn choice_cost_us(
     }
 }
 
+/// What a game under the budget policy took, frame by frame, against what the cost model
+/// says of its parts.
+struct InPlay {
+    /// The frames' median, us.
+    median_us: f64,
+    /// The model's fixed cost, the searches for contacts and the levels below rigid, on
+    /// average, us.
+    cheap_us: f64,
+    /// The rigid creatures' figures on average, us, and how many there were.
+    rigid_us: f64,
+    rigid: f64,
+}
+
+/// The scenario's mix of `count` creatures under the budget policy at `room_us` a frame,
+/// priced by `model`, every frame timed after a warm-up, each beside what `model` says of the
+/// levels its creatures ran at (read after the frame) and of its searches.
+fn in_play(
+    config: &SimConfig,
+    model: &CostModel,
+    count: u32,
+    room_us: f64,
+    (warmup, frames): (usize, usize),
+) -> InPlay {
+    let mut game = scaled(config, count, LevelPolicy::Budget);
+    game.costs = model.clone();
+    let costs = game.costs_by_kind(0);
+    let budget = &mut game.rules.budget;
+    (budget.frame_budget_ms, budget.adaptive_frames) = ((room_us / 1e3) as f32, 0.0);
+    let mut sim = HeadlessSim::new(game);
+    for _ in 0..warmup {
+        sim.advance_frame();
+    }
+    let (mut measured, mut cheap_us, mut rigid_us, mut rigid) = (Vec::with_capacity(frames), 0.0, 0.0, 0u64);
+    for _ in 0..frames {
+        let searched_before = sim.app.world().resource::<BudgetTally>().searched;
+        measured.push(timed_frame(&mut sim) * 1e6);
+        let world = sim.app.world_mut();
+        let searched = world.resource::<BudgetTally>().searched - searched_before;
+        cheap_us += f64::from(model.fixed_us_per_frame) + searched as f64 * f64::from(model.contact_search_us);
+        for (c, &lod) in world.query::<(&Creature, &Lod)>().iter(world) {
+            let us = f64::from(costs[c.kind].per_frame_us(lod));
+            if lod == Lod::Rigid {
+                (rigid_us, rigid) = (rigid_us + us, rigid + 1);
+            } else {
+                cheap_us += us;
+            }
+        }
+    }
+    let n = frames.max(1) as f64;
+    InPlay {
+        median_us: median(measured),
+        cheap_us: cheap_us / n,
+        rigid_us: rigid_us / n,
+        rigid: rigid as f64 / n,
+    }
+}
+
+/// What `model` says a creature of the scenario's mix costs at `level` among `count`.
+fn mix_us(config: &SimConfig, model: &CostModel, count: u32, level: Lod) -> f64 {
+    let mut game = scaled(config, count, LevelPolicy::Budget);
+    game.costs = model.clone();
+    let costs = game.costs_by_kind(0);
+    (game.scenario.creatures.iter().zip(&costs))
+        .map(|(g, c)| f64::from(g.count) * f64::from(c.per_frame_us(level)))
+        .sum::<f64>()
+        / f64::from(count.max(1))
+}
+
+/// The choice's cost per creature in play: the scenario's crowd of `count` under the budget
+/// with room for about half of it at the hybrid level and none rigid (the rigid level priced
+/// out of reach), what its frames take beyond the model's fixed cost and levels. Besides the
+/// choice itself (`choice_now`), this is the writing of every creature's level, the switch
+/// stage's passes, the switches between the cheap levels and a world of a table for each
+/// level: timed as the choice alone, the cheap levels in a world of mixed levels ran about
+/// twice their prediction at 4,000 creatures, and 100,000 under the camera rule 1.3 times all
+/// hybrid's stages.
+fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us: f64, effort: (usize, usize)) -> f64 {
+    let mut priced = model.clone();
+    for k in &mut priced.kinds {
+        k.costs.rigid_us_per_frame = 1e6;
+    }
+    priced.other_kinds.rigid_us_per_frame = 1e6;
+    let (pm, hybrid) = (
+        mix_us(config, &priced, count, Lod::PointMass),
+        mix_us(config, &priced, count, Lod::Hybrid),
+    );
+    let room_us = f64::from(model.fixed_us_per_frame) + f64::from(count) * (alone_us + (pm + hybrid) / 2.0);
+    let game = in_play(config, &priced, count, room_us, effort);
+    ((game.median_us - game.cheap_us) / f64::from(count.max(1))).max(0.0)
+}
+
+/// The rigid level's cost in play as a share of its kinds' figures (which are measured in open
+/// court, among a few tens of one kind): the scenario's mix of four times `rigid` creatures
+/// under the budget policy with room for about `rigid` rigid ones, those it picks (about to
+/// touch something, or in view). The share is what its frames take (their median) beyond the
+/// rest of what the model predicts of them (the fixed cost, the choice and its searches, the
+/// cheaper levels), over the rigid creatures' figures. Rapier works through its contacts
+/// across the cores once it has more than 64 to update, so that a rigid creature among a
+/// hundred or two costs about two thirds of one among tens; among more, rapier's own work per
+/// body grows again (4,000 all rigid: 72 us a hopper or biped in its stage against 47 among
+/// 443); and one about to touch something costs the solver more than one in open court.
+fn rigid_in_play(config: &SimConfig, model: &CostModel, rigid: u32, effort: (usize, usize)) -> RigidShare {
+    let count = 4 * rigid;
+    let room_us = f64::from(model.overhead_us(count as usize))
+        + f64::from(count)
+            * mix_us(config, model, count, Lod::Hybrid).max(mix_us(config, model, count, Lod::PointMass))
+        + f64::from(rigid) * mix_us(config, model, count, Lod::Rigid);
+    let game = in_play(config, model, count, room_us, effort);
+    let choice_us = f64::from(model.overhead_us(count as usize) - model.fixed_us_per_frame);
+    RigidShare {
+        rigid: game.rigid.round().max(1.0) as u32,
+        share: ((game.median_us - game.cheap_us - choice_us) / game.rigid_us.max(1e-9)).clamp(0.01, 10.0) as f32,
+    }
+}
+
 /// Microseconds a creature that the budget policy adds to a frame where not one step up fits:
 /// its scenario's crowd of `count` under the budget policy with no room, each creature at its
 /// floor, against the same crowd at the cheapest level under a fixed policy, the two stepped a
@@ -579,7 +727,7 @@ fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
 const SWITCH_PAIRS: usize = 5;
 
 /// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
-/// choice's, and the crowd's shares.
+/// choice's, the crowd's shares, and the rigid level's among more rigid creatures.
 pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
     let mut lines: Vec<String> = (model.kinds.iter())
         .map(|k| {
@@ -603,6 +751,15 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
             shares.creatures, shares.point_mass, shares.hybrid, shares.choice, shares.floors_only
         ));
     }
+    if !model.rigid_shares.is_empty() {
+        let shares: Vec<String> = (model.rigid_shares.iter())
+            .map(|r| format!("{} x {:.2}", r.rigid, r.share))
+            .collect();
+        lines.push(format!(
+            "the rigid level in play among this many rigid creatures: {}",
+            shares.join(", ")
+        ));
+    }
     lines
 }
 
@@ -611,6 +768,6 @@ pub fn costs_file_text(model: &CostModel, command: &str) -> String {
     let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
     let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
     format!(
-        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature (and where only the\n// floors fit) and per creature it searches for contacts, in microseconds (medians), measured\n// by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature (and where only the\n// floors fit) and per creature it searches for contacts, in microseconds (medians), and the\n// shares of those costs in crowds and among many rigid creatures, measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
     )
 }
