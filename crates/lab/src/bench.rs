@@ -727,7 +727,7 @@ fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
 const SWITCH_PAIRS: usize = 5;
 
 /// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
-/// choice's, the crowd's shares, and the rigid level's among more rigid creatures.
+/// choice's, the crowd's shares, and the rigid level's in play among more rigid creatures.
 pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
     let mut lines: Vec<String> = (model.kinds.iter())
         .map(|k| {
