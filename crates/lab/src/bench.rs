@@ -619,15 +619,17 @@ fn in_play(
     }
 }
 
-/// What `model` says a creature of the scenario's mix costs at `level` among `count`.
-fn mix_us(config: &SimConfig, model: &CostModel, count: u32, level: Lod) -> f64 {
+/// What `model` says a creature of the scenario's mix costs at each level among `count`.
+fn mix_us(config: &SimConfig, model: &CostModel, count: u32) -> [f64; 3] {
     let mut game = scaled(config, count, LevelPolicy::Budget);
     game.costs = model.clone();
     let costs = game.costs_by_kind(0);
-    (game.scenario.creatures.iter().zip(&costs))
-        .map(|(g, c)| f64::from(g.count) * f64::from(c.per_frame_us(level)))
-        .sum::<f64>()
-        / f64::from(count.max(1))
+    Lod::ALL.map(|level| {
+        (game.scenario.creatures.iter().zip(&costs))
+            .map(|(g, c)| f64::from(g.count) * f64::from(c.per_frame_us(level)))
+            .sum::<f64>()
+            / f64::from(count.max(1))
+    })
 }
 
 /// The choice's cost per creature in play: the scenario's crowd of `count` under the budget
@@ -644,10 +646,7 @@ fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us
         k.costs.rigid_us_per_frame = 1e6;
     }
     priced.other_kinds.rigid_us_per_frame = 1e6;
-    let (pm, hybrid) = (
-        mix_us(config, &priced, count, Lod::PointMass),
-        mix_us(config, &priced, count, Lod::Hybrid),
-    );
+    let [pm, hybrid, _] = mix_us(config, &priced, count);
     let room_us = f64::from(model.fixed_us_per_frame) + f64::from(count) * (alone_us + (pm + hybrid) / 2.0);
     let game = in_play(config, &priced, count, room_us, effort);
     ((game.median_us - game.cheap_us) / f64::from(count.max(1))).max(0.0)
@@ -665,10 +664,9 @@ fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us
 /// 443); and one about to touch something costs the solver more than one in open court.
 fn rigid_in_play(config: &SimConfig, model: &CostModel, rigid: u32, effort: (usize, usize)) -> RigidShare {
     let count = 4 * rigid;
-    let room_us = f64::from(model.overhead_us(count as usize))
-        + f64::from(count)
-            * mix_us(config, model, count, Lod::Hybrid).max(mix_us(config, model, count, Lod::PointMass))
-        + f64::from(rigid) * mix_us(config, model, count, Lod::Rigid);
+    let [pm, hybrid, rigid_us] = mix_us(config, model, count);
+    let room_us =
+        f64::from(model.overhead_us(count as usize)) + f64::from(count) * hybrid.max(pm) + f64::from(rigid) * rigid_us;
     let game = in_play(config, model, count, room_us, effort);
     let choice_us = f64::from(model.overhead_us(count as usize) - model.fixed_us_per_frame);
     RigidShare {
