@@ -40,8 +40,9 @@ pub struct CostModel {
     #[serde(default)]
     pub contact_search_us: f32,
     /// What the point-mass and hybrid levels and the choice cost per creature in a crowd, where
-    /// they run across the cores, as shares of the figures above (measured on one thread, the
-    /// choice at 2,000 creatures): at the smallest crowd measured. A file without it predicts a
+    /// they run across the cores, and the rigid level among the crowd, as shares of the figures
+    /// above (measured on one thread, the choice at 2,000 creatures, the rigid level at its
+    /// `rigid_shares`): at the smallest crowd measured. A file without it predicts a
     /// crowd at those figures.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub crowd_shares: Option<CrowdShares>,
@@ -96,6 +97,11 @@ pub struct CrowdShares {
     /// on one thread in any crowd, so its share stays near 1.
     #[serde(default = "CrowdShares::whole")]
     pub floors_only: f32,
+    /// Of the rigid level's cost at its share among as many rigid creatures (`rigid_shares`,
+    /// measured in crowds of four times the rigid ones): among tens of thousands of cheaper
+    /// creatures, a rigid one costs more in the stages beside rapier's (a file without it: 1).
+    #[serde(default = "CrowdShares::whole")]
+    pub rigid: f32,
 }
 
 impl CrowdShares {
@@ -186,13 +192,14 @@ impl CostModel {
     }
 
     /// The costs of the kind named `kind` in a world of `creatures`, `rigid` of them rigid: in
-    /// a crowd, the cheap levels at their crowd shares; the rigid level at its share among
-    /// that many.
+    /// a crowd, each level at its crowd share; the rigid level also at its share among that
+    /// many rigid creatures.
     pub fn in_crowd(&self, kind: &str, creatures: u32, rigid: u32) -> LevelCosts {
         let mut costs = *self.of(kind);
         if let Some(shares) = self.shares_in_crowd(creatures) {
             costs.point_mass_us_per_frame *= shares.point_mass;
             costs.hybrid_us_per_frame *= shares.hybrid;
+            costs.rigid_us_per_frame *= shares.rigid;
         }
         costs.rigid_us_per_frame *= self.rigid_share(rigid);
         costs
@@ -231,6 +238,7 @@ impl CostModel {
                     hybrid: at(below.hybrid, above.hybrid),
                     choice: at(below.choice, above.choice),
                     floors_only: at(below.floors_only, above.floors_only),
+                    rigid: at(below.rigid, above.rigid),
                 });
             }
             below = *above;
@@ -294,6 +302,7 @@ impl Validate for CostModel {
             v.within("hybrid", shares.hybrid, 0.01, 10.0);
             v.within("choice", shares.choice, 0.01, 10.0);
             v.within("floors_only", shares.floors_only, 0.01, 10.0);
+            v.within("rigid", shares.rigid, 0.01, 10.0);
         };
         if let Some(first) = &self.crowd_shares {
             v.nested("crowd_shares", |v| {
@@ -382,7 +391,7 @@ mod tests {
     fn a_crowd_between_two_measured_takes_a_share_between_theirs_on_the_logarithm_of_its_count() {
         let text = format!(
             "(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((creatures: 4096, point_mass: 1.0, hybrid: 1.0)), \
-             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75, choice: 0.5, floors_only: 2.0)])"
+             larger_crowd_shares: [(creatures: 16384, point_mass: 0.5, hybrid: 0.75), (creatures: 65536, point_mass: 0.25, hybrid: 0.75, choice: 0.5, floors_only: 2.0, rigid: 3.0)])"
         );
         let mut model: CostModel = parse_ron(text.as_bytes(), Path::new("costs.ron")).unwrap();
         // The choice's share too (a share left out is 1): none short of a crowd.
@@ -410,6 +419,11 @@ mod tests {
         assert!((point_mass(32_768) - 0.375).abs() < 1e-5, "{}", point_mass(32_768));
         assert_eq!(point_mass(16_384), 0.5);
         assert!((model.in_crowd("hopper", 8192, 0).hybrid_us_per_frame - 1.75).abs() < 1e-5);
+        // The rigid level among the crowd: its share left out is 1, and 3 at the largest.
+        let rigid = |n| model.in_crowd("hopper", n, 0).rigid_us_per_frame;
+        assert_eq!(rigid(4096), 100.0);
+        assert!((rigid(32_768) - 200.0).abs() < 1e-3, "{}", rigid(32_768));
+        assert_eq!(rigid(1_000_000), 300.0);
         // A file of one share, from before the counts: measured at 16,384, for every crowd.
         let old: CostModel = parse_ron(
             format!("(kinds: [], other_kinds: {COSTS}, crowd_shares: Some((point_mass: 0.5, hybrid: 0.5)))").as_bytes(),
@@ -429,6 +443,9 @@ mod tests {
             err.to_string().contains("`larger_crowd_shares[1].floors_only`"),
             "{err}"
         );
+        let rigid_out = text.replace("rigid: 3.0", "rigid: 11");
+        let err = parse_ron::<CostModel>(rigid_out.as_bytes(), Path::new("costs.ron")).unwrap_err();
+        assert!(err.to_string().contains("`larger_crowd_shares[1].rigid`"), "{err}");
         let last = text.replace("creatures: 4096", &format!("creatures: {}", u32::MAX));
         let err = parse_ron::<CostModel>(last.as_bytes(), Path::new("costs.ron")).unwrap_err();
         assert!(err.to_string().contains("`larger_crowd_shares[0].creatures`"), "{err}");

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 
 use crate::support::*;
 use simlod::arena::PuckState;
-use simlod::config::{CostModel, LevelCosts, RigidShare, SimConfig};
+use simlod::config::{CostModel, CrowdShares, LevelCosts, RigidShare, SimConfig};
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
 use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
@@ -126,6 +126,36 @@ fn the_rigid_level_is_priced_at_its_share_among_as_many_rigid_creatures_as_there
     assert!(
         cheaper > 1.5 * at_figure,
         "{cheaper} rigid on average against {at_figure}"
+    );
+}
+
+#[test]
+fn among_a_crowd_the_rigid_level_is_priced_at_the_crowds_share_too() {
+    // A crowd stepped across the cores in a court grown to the same density, with room for
+    // every creature at the hybrid level (2 us) and some thirty rigid steps at the figure:
+    // fewer once a rigid creature costs three times as much among the crowd.
+    let creatures = simlod::PARALLEL_MIN_CREATURES;
+    let budget_ms = (f64::from(creatures) * 2e-3 + 3.0) as f32;
+    let rigid_on_average = |rigid: f32| {
+        let mut config = simlod_lab::scene::scaled(&budget_scene(40, budget_ms), creatures, LevelPolicy::Budget);
+        config.costs.crowd_shares = Some(CrowdShares {
+            creatures,
+            point_mass: 1.0,
+            hybrid: 1.0,
+            choice: 1.0,
+            floors_only: 1.0,
+            rigid,
+        });
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(5.0);
+        let summary = sim.summary(0.0);
+        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
+        summary.levels_mean[Lod::Rigid]
+    };
+    let (at_figure, dearer) = (rigid_on_average(1.0), rigid_on_average(3.0));
+    assert!(
+        at_figure > 1.5 * dearer && dearer > 0.0,
+        "{dearer} rigid on average at three times the figure against {at_figure}"
     );
 }
 

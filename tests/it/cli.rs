@@ -146,6 +146,39 @@ fn calibrating_writes_a_cost_model_that_loads_even_for_rules_whose_model_is_not_
     // The rigid level in play, among few rigid creatures and among many (the file loaded, so
     // the counts rise).
     assert_eq!(model.rigid_shares.len(), 2, "{model:?}");
+    // The quick calibration's one crowd: the choice and the rigid level among it
+    // measured (a share left unmeasured is exactly 1).
+    let crowd = model.crowd_shares.expect("a crowd measured");
+    assert!(model.larger_crowd_shares.is_empty(), "{model:?}");
+    assert!(crowd.choice != 1.0 && crowd.rigid != 1.0, "{crowd:?}");
+}
+
+#[test]
+fn bench_choice_times_the_budgets_choice_as_it_plays_and_with_room_for_every_step() {
+    let out = simlod(&["bench", "--choice", "--quick", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let timed: Vec<serde_json::Value> = (String::from_utf8_lossy(&out.stdout).lines())
+        .map(|line| serde_json::from_str(line).expect("a JSON object a line"))
+        .collect();
+    let [played, every_step] = &timed[..] else {
+        panic!("two objects: {timed:?}")
+    };
+    assert_eq!(played["creatures"], 20_000);
+    assert_eq!(
+        (&played["frame_budget_ms"], &played["searches"]),
+        (&30.0.into(), &true.into())
+    );
+    assert_eq!(
+        (
+            &every_step["frame_budget_ms"],
+            &every_step["searches"],
+            &every_step["searched"]
+        ),
+        (&serde_json::Value::Null, &false.into(), &0.into())
+    );
+    for t in &timed {
+        assert!(t["us_per_creature_per_frame"].as_f64().unwrap() > 0.0, "{t}");
+    }
 }
 
 fn refused(args: &[&str], says: &str) {
@@ -165,6 +198,7 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
     refused(&["run", "--puck-radius", "-3"], "between 0 and 10000 metres, got -3");
     refused(&["run", "--frame-budget", "-1"], "10000 ms");
     refused(&["run", "--seconds", "-2"], "more than 0");
+    refused(&["bench", "--choice", "--level", "rigid"], "cannot be used with");
     // A flag the run's policy never reads is refused, not ignored.
     refused(
         &["run", "--policy", "combined", "--frame-budget", "1"],

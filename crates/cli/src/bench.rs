@@ -25,6 +25,10 @@ pub(crate) struct BenchArgs {
     /// Only the scenario's creatures of this kind (for example `biped`): its cost at each level.
     #[arg(long, conflicts_with = "calibrate")]
     pub(crate) kind: Option<String>,
+    /// Only the budget policy's choice among 100,000 creatures (20,000 with `--quick`): as it
+    /// plays under a 30 ms budget, and with room for every step and no searches.
+    #[arg(long, conflicts_with_all = ["calibrate", "level"])]
+    pub(crate) choice: bool,
     /// Measure the budget policy's cost model (each kind's levels and its switch into rigid)
     /// and write it to the file the level rules name (`budget.cost_model`), or to `--out`.
     #[arg(long)]
@@ -53,7 +57,11 @@ impl BenchArgs {
         if self.calibrate {
             return self.calibrate(&config);
         }
-        simlod_lab::bench::run(&config, self.quick, self.json, self.level);
+        if self.choice {
+            simlod_lab::bench::run_choice(&config, self.quick, self.json);
+        } else {
+            simlod_lab::bench::run(&config, self.quick, self.json, self.level);
+        }
         Ok(())
     }
 

@@ -96,6 +96,57 @@ fn median_of_runs(config: &SimConfig, runs: usize, warmup: usize, frames: usize)
     )
 }
 
+/// What `simlod bench --json` prints for the budget policy's choice, one object per way timed.
+#[derive(Clone, Debug, Serialize)]
+pub struct ChoiceBench {
+    /// The scenario's mix scaled to this many creatures, its court to the same density.
+    pub creatures: u32,
+    /// The frame budget the choice was made under, ms (`null`: room for every step).
+    pub frame_budget_ms: Option<f32>,
+    /// Whether creatures were searched for contacts with the others (the rules' weight of
+    /// such a contact); without, the choice's work for every creature alone.
+    pub searches: bool,
+    /// Median wall time of one choice per creature, us: a choice is made each 1/30 s.
+    pub us_per_creature_per_frame: f64,
+    /// Creatures searched for contacts in a choice.
+    pub searched: usize,
+    /// Choices timed.
+    pub choices: usize,
+}
+
+/// The budget policy's choice in the scenario's mix of `creatures`, after `warmup` frames of
+/// play under `budget_ms` (the scenario's rules and cost model): timed `choices` times at that
+/// moment (`choice_now`, not applied, so each is the same choice): as it plays there, its
+/// searches those whose last search no longer stands; and with room for every step and no
+/// searches (each creature's bounds, steps and the knapsack over them all: what
+/// `--calibrate` times).
+fn choice_bench(
+    config: &SimConfig,
+    creatures: u32,
+    budget_ms: f32,
+    (warmup, choices): (usize, usize),
+) -> [ChoiceBench; 2] {
+    let mut game = scaled(config, creatures, LevelPolicy::Budget);
+    (game.rules.budget.frame_budget_ms, game.rules.budget.adaptive_frames) = (budget_ms, 0.0);
+    let mut sim = HeadlessSim::new(game);
+    for _ in 0..warmup {
+        sim.advance_frame();
+    }
+    let weight = config.rules.budget.creature_weight;
+    [(Some(budget_ms), weight), (None, 0.0)].map(|(frame_budget_ms, creature_weight)| {
+        let budget_ms = frame_budget_ms.unwrap_or(f32::MAX);
+        let (us, searched) = timed_choice(&mut sim, budget_ms, creature_weight, choices);
+        ChoiceBench {
+            creatures,
+            frame_budget_ms,
+            searches: creature_weight > 0.0,
+            us_per_creature_per_frame: us / f64::from(creatures.max(1)),
+            searched,
+            choices,
+        }
+    })
+}
+
 /// How hard one level is measured.
 struct Effort {
     /// The creature count the cost per creature is measured at.
@@ -241,6 +292,27 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
     }
     if only.is_none() {
         game_speedup(config, runs, warmup, frames, json);
+        run_choice(config, quick, json);
+    }
+}
+
+/// Times the budget policy's choice among 100,000 creatures (a fifth `quick`) and prints it
+/// ([`choice_bench`]).
+pub fn run_choice(config: &SimConfig, quick: bool, json: bool) {
+    let (creatures, effort) = if quick { (20_000, (10, 15)) } else { (100_000, (30, 45)) };
+    for choice in choice_bench(config, creatures, 30.0, effort) {
+        if json {
+            println!("{}", serde_json::to_string(&choice).expect("a bench result serialises"));
+        } else {
+            let how = match choice.frame_budget_ms {
+                Some(b) => format!("as it plays under a {b} ms budget ({} searched)", choice.searched),
+                None => "with room for every step, no searches".to_owned(),
+            };
+            println!(
+                "the budget's choice among {} creatures, {how}: {:.3} us per creature per frame",
+                choice.creatures, choice.us_per_creature_per_frame
+            );
+        }
     }
 }
 
@@ -396,10 +468,10 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     let mut fewer = 0;
     model.rigid_shares = (rigid_counts.iter())
         .map(|&rigid| {
-            let mut share = rigid_in_play(config, &model, rigid, (warmup.max(30), frames));
-            share.rigid = share.rigid.max(fewer + 1);
-            fewer = share.rigid;
-            share
+            let (rigid, share) = rigid_in_play(config, &model, 4 * rigid, rigid, (warmup.max(30), frames));
+            let rigid = rigid.max(fewer + 1);
+            fewer = rigid;
+            RigidShare { rigid, share }
         })
         .collect();
     // The cheap levels in crowds stepped across the cores: the scenario's mix at each crowd
@@ -424,26 +496,56 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     let choice_at = |count| choice_cost_us(config, &model, count, (warmup, frames.div_ceil(3)), false);
     let alone = choice_at(cheap_count);
     let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
-    let choice: Vec<(f32, f32)> = (crowds.iter())
-        .map(|&count| {
-            let crowd = choice_at(count);
-            (
-                share(crowd.per_creature_us, alone.per_creature_us),
-                share(crowd.floors_only_us, alone.floors_only_us),
-            )
-        })
-        .collect();
-    let mut measured = (crowds.iter().zip(point_mass.iter().zip(&hybrid)).zip(&choice)).map(
-        |((&creatures, (&point_mass, &hybrid)), &(choice, floors_only))| CrowdShares {
+    let choice: Vec<ChoiceCost> = crowds.iter().map(|&count| choice_at(count)).collect();
+    let mut measured: Vec<CrowdShares> = (crowds.iter().zip(point_mass.iter().zip(&hybrid)).zip(&choice))
+        .map(|((&creatures, (&point_mass, &hybrid)), crowd)| CrowdShares {
             creatures,
             point_mass,
             hybrid,
-            choice,
-            floors_only,
-        },
-    );
-    model.crowd_shares = measured.next();
-    model.larger_crowd_shares = measured.collect();
+            choice: share(crowd.per_creature_us, alone.per_creature_us),
+            floors_only: share(crowd.floors_only_us, alone.floors_only_us),
+            rigid: 1.0,
+        })
+        .collect();
+    let with_shares = |model: &mut CostModel, measured: &[CrowdShares]| {
+        model.crowd_shares = measured.first().copied();
+        model.larger_crowd_shares = measured[1..].to_vec();
+    };
+    // Then the choice in play at each crowd's size, as at 2,000: what it does beside the choice
+    // itself (writing the levels, the switch stage's passes) is a smaller part of it there.
+    // Taken there by the choice alone's shares, the model charged 40,000 creatures at 30 ms
+    // about 13 ms too much a frame (2026-11-28).
+    with_shares(&mut model, &measured);
+    for (shares, crowd) in measured.iter_mut().zip(&choice) {
+        let in_play = choice_in_play_us(
+            config,
+            &model,
+            shares.creatures,
+            crowd.per_creature_us,
+            (warmup.max(30), frames),
+        );
+        shares.choice = share(in_play, f64::from(model.decision_us_per_creature));
+    }
+    // Then the rigid level among each crowd, at its share among as many rigid creatures: among
+    // tens of thousands it cost more than among four times the rigid ones (100,000 creatures at
+    // 30 ms ran 1.21 times the budget without it, 2026-11-27). The cheap levels and the choice
+    // at their shares just measured.
+    with_shares(&mut model, &measured);
+    let rigid_among = match how {
+        Calibration::Quick => 100,
+        _ => 400,
+    };
+    // Only beyond twice the largest crowd the rigid shares were measured in: nearer, they hold
+    // (the smallest crowd's share measured 0.84 to 1.33 in seven calibrations in an hour,
+    // 2026-11-28, where they say 1).
+    let largest = 4 * rigid_counts.last().copied().unwrap_or(0);
+    for i in 0..measured.len() {
+        let count = measured[i].creatures;
+        if count > 2 * largest {
+            (_, measured[i].rigid) = rigid_in_play(config, &model, count, rigid_among, (warmup.max(30), frames));
+            with_shares(&mut model, &measured);
+        }
+    }
     model
 }
 
@@ -463,6 +565,7 @@ fn median_model(models: &[CostModel]) -> CostModel {
         hybrid: median_of(&|m| shares(m).hybrid),
         choice: median_of(&|m| shares(m).choice),
         floors_only: median_of(&|m| shares(m).floors_only),
+        rigid: median_of(&|m| shares(m).rigid),
     };
     let first = &models[0];
     let mut model = CostModel {
@@ -505,6 +608,26 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
     }
 }
 
+/// The budget policy's choice for the world as it stands under `budget_ms`, a contact with
+/// another creature weighed `creature_weight`, timed `calls` times (not applied, so each is
+/// the same choice): the median, us, and the creatures it searched.
+fn timed_choice(sim: &mut HeadlessSim, budget_ms: f32, creature_weight: f32, calls: usize) -> (f64, usize) {
+    let world = sim.app.world_mut();
+    let mut config = world.resource_mut::<SimConfig>();
+    (config.rules.budget.frame_budget_ms, config.rules.budget.creature_weight) = (budget_ms, creature_weight);
+    let mut searched = 0;
+    let us = median(
+        (0..calls)
+            .map(|_| {
+                let start = Instant::now();
+                searched = simlod::lod::choice_now(world).map_or(0, |a| a.settled.len());
+                start.elapsed().as_secs_f64() * 1e6
+            })
+            .collect(),
+    );
+    (us, searched)
+}
+
 /// What the budget policy's own choice costs, microseconds: per creature without the search
 /// for contacts between creatures, per creature where only the floors fit, and per creature
 /// searched.
@@ -530,23 +653,8 @@ fn choice_cost_us(
     for _ in 0..warmup {
         sim.advance_frame();
     }
-    let mut time_choice = |creature_weight: f32, budget_ms: f32| {
-        let world = sim.app.world_mut();
-        let mut sim_config = world.resource_mut::<SimConfig>();
-        (sim_config.costs, sim_config.rules.budget.frame_budget_ms) = (model.clone(), budget_ms);
-        sim_config.rules.budget.creature_weight = creature_weight;
-        let mut searched = 0;
-        let us = median(
-            (0..calls)
-                .map(|_| {
-                    let start = Instant::now();
-                    searched = simlod::lod::choice_now(world).map_or(0, |a| a.settled.len());
-                    start.elapsed().as_secs_f64() * 1e6
-                })
-                .collect(),
-        );
-        (us, searched)
-    };
+    sim.app.world_mut().resource_mut::<SimConfig>().costs = model.clone();
+    let mut time_choice = |creature_weight, budget_ms| timed_choice(&mut sim, budget_ms, creature_weight, calls);
     let per_creature = |us: f64| us / f64::from(count.max(1));
     let (unsearched_us, _) = time_choice(0.0, f32::MAX);
     let search_us = if with_searches {
@@ -587,10 +695,9 @@ fn in_play(
 ) -> InPlay {
     let mut game = scaled(config, count, LevelPolicy::Budget);
     game.costs = model.clone();
-    let costs = game.costs_by_kind(0);
     let budget = &mut game.rules.budget;
     (budget.frame_budget_ms, budget.adaptive_frames) = ((room_us / 1e3) as f32, 0.0);
-    let mut sim = HeadlessSim::new(game);
+    let mut sim = HeadlessSim::new(game.clone());
     for _ in 0..warmup {
         sim.advance_frame();
     }
@@ -601,7 +708,10 @@ fn in_play(
         let world = sim.app.world_mut();
         let searched = world.resource::<BudgetTally>().searched - searched_before;
         cheap_us += f64::from(model.fixed_us_per_frame) + searched as f64 * f64::from(model.contact_search_us);
-        for (c, &lod) in world.query::<(&Creature, &Lod)>().iter(world) {
+        let mut levels = world.query::<(&Creature, &Lod)>();
+        let rigid_now = levels.iter(world).filter(|(_, lod)| **lod == Lod::Rigid).count();
+        let costs = game.costs_by_kind(rigid_now as u32);
+        for (c, &lod) in levels.iter(world) {
             let us = f64::from(costs[c.kind].per_frame_us(lod));
             if lod == Lod::Rigid {
                 (rigid_us, rigid) = (rigid_us + us, rigid + 1);
@@ -619,11 +729,12 @@ fn in_play(
     }
 }
 
-/// What `model` says a creature of the scenario's mix costs at each level among `count`.
-fn mix_us(config: &SimConfig, model: &CostModel, count: u32) -> [f64; 3] {
+/// What `model` says a creature of the scenario's mix costs at each level among `count`,
+/// `rigid` of them rigid.
+fn mix_us(config: &SimConfig, model: &CostModel, count: u32, rigid: u32) -> [f64; 3] {
     let mut game = scaled(config, count, LevelPolicy::Budget);
     game.costs = model.clone();
-    let costs = game.costs_by_kind(0);
+    let costs = game.costs_by_kind(rigid);
     Lod::ALL.map(|level| {
         (game.scenario.creatures.iter().zip(&costs))
             .map(|(g, c)| f64::from(g.count) * f64::from(c.per_frame_us(level)))
@@ -634,45 +745,85 @@ fn mix_us(config: &SimConfig, model: &CostModel, count: u32) -> [f64; 3] {
 
 /// The choice's cost per creature in play: the scenario's crowd of `count` under the budget
 /// with room for about half of it at the hybrid level and none rigid (the rigid level priced
-/// out of reach), what its frames take beyond the model's fixed cost and levels. Besides the
-/// choice itself (`choice_now`), this is the writing of every creature's level, the switch
-/// stage's passes, the switches between the cheap levels and a world of a table for each
-/// level: timed as the choice alone, the cheap levels in a world of mixed levels ran about
-/// twice their prediction at 4,000 creatures, and 100,000 under the camera rule 1.3 times all
-/// hybrid's stages.
-fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us: f64, effort: (usize, usize)) -> f64 {
+/// out of reach, the choice charged at `alone_us`, the choice alone timed among `count`), what
+/// its frames take beyond its levels and its searches. Besides the choice itself
+/// (`choice_now`), this is the writing of every creature's level, the switch stage's passes,
+/// the switches between the cheap levels and a world of a table for each level: timed as the
+/// choice alone, the cheap levels in a world of mixed levels ran about twice their prediction
+/// at 4,000 creatures, and 100,000 under the camera rule 1.3 times all hybrid's stages. Its
+/// levels are priced by the same crowd all point masses and all hybrid, the three stepped a
+/// frame each in turn (see [`median_extra_seconds`]): priced by shares measured apart, the
+/// choice's part came out at nothing in one calibration and a third of the next's.
+fn choice_in_play_us(
+    config: &SimConfig,
+    model: &CostModel,
+    count: u32,
+    alone_us: f64,
+    (warmup, frames): (usize, usize),
+) -> f64 {
     let mut priced = model.clone();
     for k in &mut priced.kinds {
         k.costs.rigid_us_per_frame = 1e6;
     }
     priced.other_kinds.rigid_us_per_frame = 1e6;
-    let [pm, hybrid, _] = mix_us(config, &priced, count);
-    let room_us = f64::from(model.fixed_us_per_frame) + f64::from(count) * (alone_us + (pm + hybrid) / 2.0);
-    let game = in_play(config, &priced, count, room_us, effort);
-    ((game.median_us - game.cheap_us) / f64::from(count.max(1))).max(0.0)
+    priced.decision_us_per_creature = alone_us as f32;
+    for shares in priced.crowd_shares.iter_mut().chain(&mut priced.larger_crowd_shares) {
+        shares.choice = 1.0;
+    }
+    let [pm, hybrid, _] = mix_us(config, &priced, count, 0);
+    let room_us = f64::from(priced.overhead_us(count as usize)) + f64::from(count) * (pm + hybrid) / 2.0;
+    let mut choosing = scaled(config, count, LevelPolicy::Budget);
+    choosing.costs = priced;
+    let budget = &mut choosing.rules.budget;
+    (budget.frame_budget_ms, budget.adaptive_frames) = ((room_us / 1e3) as f32, 0.0);
+    let mut sims = [
+        choosing,
+        scaled(config, count, LevelPolicy::AllPointMass),
+        scaled(config, count, LevelPolicy::AllHybrid),
+    ]
+    .map(HeadlessSim::new);
+    for _ in 0..warmup {
+        sims.iter_mut().for_each(HeadlessSim::advance_frame);
+    }
+    let searched = |sim: &HeadlessSim| sim.app.world().resource::<BudgetTally>().searched;
+    let extra_s = (0..frames)
+        .map(|_| {
+            let before = searched(&sims[0]);
+            let [choosing_s, points_s, hybrids_s] = sims.each_mut().map(timed_frame);
+            let searches = (searched(&sims[0]) - before) as f64;
+            let world = sims[0].app.world_mut();
+            let hybrids = (world.query::<&Lod>().iter(world))
+                .filter(|&&l| l == Lod::Hybrid)
+                .count();
+            let h = hybrids as f64 / f64::from(count.max(1));
+            choosing_s - (1.0 - h) * points_s - h * hybrids_s - searches * f64::from(model.contact_search_us) * 1e-6
+        })
+        .collect();
+    (median(extra_s) * 1e6 / f64::from(count.max(1))).max(0.0)
 }
 
-/// The rigid level's cost in play as a share of its kinds' figures (which are measured in open
-/// court, among a few tens of one kind): the scenario's mix of four times `rigid` creatures
-/// under the budget policy with room for about `rigid` rigid ones, those it picks (about to
-/// touch something, or in view). The share is what its frames take (their median) beyond the
-/// rest of what the model predicts of them (the fixed cost, the choice and its searches, the
-/// cheaper levels), over the rigid creatures' figures. Rapier works through its contacts
-/// across the cores once it has more than 64 to update, so that a rigid creature among a
-/// hundred or two costs about two thirds of one among tens; among more, rapier's own work per
-/// body grows again (4,000 all rigid: 72 us a hopper or biped in its stage against 47 among
-/// 443); and one about to touch something costs the solver more than one in open court.
-fn rigid_in_play(config: &SimConfig, model: &CostModel, rigid: u32, effort: (usize, usize)) -> RigidShare {
-    let count = 4 * rigid;
-    let [pm, hybrid, rigid_us] = mix_us(config, model, count);
+/// The rigid level's cost in play as a share of what `model` says of it (among four times as
+/// many creatures as rigid ones, before any rigid share: its kinds' figures, which are measured
+/// in open court, among a few tens of one kind): the scenario's mix of `count` creatures under
+/// the budget policy with room for about `rigid` rigid ones, those it picks (about to touch
+/// something, or in view). The share is what its frames take (their median) beyond the rest of
+/// what the model predicts of them (the fixed cost, the choice and its searches, the cheaper
+/// levels), over what it predicts of the rigid creatures; with how many there were. Rapier
+/// works through its contacts across the cores once it has more than 64 to update, so that a
+/// rigid creature among a hundred or two costs about two thirds of one among tens; among more,
+/// rapier's own work per body grows again (4,000 all rigid: 72 us a hopper or biped in its
+/// stage against 47 among 443); and one about to touch something costs the solver more than
+/// one in open court.
+fn rigid_in_play(config: &SimConfig, model: &CostModel, count: u32, rigid: u32, effort: (usize, usize)) -> (u32, f32) {
+    let [pm, hybrid, rigid_us] = mix_us(config, model, count, rigid);
     let room_us =
         f64::from(model.overhead_us(count as usize)) + f64::from(count) * hybrid.max(pm) + f64::from(rigid) * rigid_us;
     let game = in_play(config, model, count, room_us, effort);
     let choice_us = f64::from(model.overhead_us(count as usize) - model.fixed_us_per_frame);
-    RigidShare {
-        rigid: game.rigid.round().max(1.0) as u32,
-        share: ((game.median_us - game.cheap_us - choice_us) / game.rigid_us.max(1e-9)).clamp(0.01, 10.0) as f32,
-    }
+    (
+        game.rigid.round().max(1.0) as u32,
+        ((game.median_us - game.cheap_us - choice_us) / game.rigid_us.max(1e-9)).clamp(0.01, 10.0) as f32,
+    )
 }
 
 /// Microseconds a creature that the budget policy adds to a frame where not one step up fits:
@@ -745,8 +896,8 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
     ));
     for shares in model.crowd_shares.iter().chain(&model.larger_crowd_shares) {
         lines.push(format!(
-            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}, the choice x {:.2}, where only the floors fit x {:.2}",
-            shares.creatures, shares.point_mass, shares.hybrid, shares.choice, shares.floors_only
+            "in a crowd of {} (across the cores): point mass x {:.2}, hybrid x {:.2}, the choice x {:.2}, where only the floors fit x {:.2}, rigid x {:.2}",
+            shares.creatures, shares.point_mass, shares.hybrid, shares.choice, shares.floors_only, shares.rigid
         ));
     }
     if !model.rigid_shares.is_empty() {
