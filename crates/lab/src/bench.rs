@@ -297,7 +297,7 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
 }
 
 /// Times the budget policy's choice among 100,000 creatures (a fifth `quick`) and prints it
-/// ([`choice_bench`]).
+/// (see `choice_bench`).
 pub fn run_choice(config: &SimConfig, quick: bool, json: bool) {
     let (creatures, effort) = if quick { (20_000, (10, 15)) } else { (100_000, (30, 45)) };
     for choice in choice_bench(config, creatures, 30.0, effort) {
