@@ -678,7 +678,8 @@ struct InPlay {
     /// The model's fixed cost, the searches for contacts and the levels below rigid, on
     /// average, us.
     cheap_us: f64,
-    /// The rigid creatures' figures on average, us, and how many there were.
+    /// What the model says of the rigid creatures (at its share for as many) on average, us,
+    /// and how many there were.
     rigid_us: f64,
     rigid: f64,
 }
