@@ -37,6 +37,16 @@ fn budget_scene(hoppers: u32, budget_ms: f32) -> SimConfig {
     config
 }
 
+/// The rigid creatures on average over a game of `seconds` under the budget, whose every
+/// decision it kept.
+fn rigid_on_average_within_budget(config: SimConfig, seconds: f64) -> f64 {
+    let mut sim = HeadlessSim::new(config);
+    sim.run_for(seconds);
+    let summary = sim.summary(0.0);
+    assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
+    summary.levels_mean[Lod::Rigid]
+}
+
 /// What the creatures' levels cost now, by the cost model.
 fn cost_of_levels_us(sim: &mut HeadlessSim) -> f32 {
     let world = sim.app.world_mut();
@@ -116,11 +126,7 @@ fn the_rigid_level_is_priced_at_its_share_among_as_many_rigid_creatures_as_there
     let rigid_on_average = |rigid_shares: Vec<RigidShare>| {
         let mut config = budget_scene(30, 0.6);
         config.costs.rigid_shares = rigid_shares;
-        let mut sim = HeadlessSim::new(config);
-        sim.run_for(10.0);
-        let summary = sim.summary(0.0);
-        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
-        summary.levels_mean[Lod::Rigid]
+        rigid_on_average_within_budget(config, 10.0)
     };
     let (at_figure, cheaper) = (rigid_on_average(Vec::new()), rigid_on_average(shares(1.0 / 3.0)));
     assert!(
@@ -146,11 +152,7 @@ fn among_a_crowd_the_rigid_level_is_priced_at_the_crowds_share_too() {
             floors_only: 1.0,
             rigid,
         });
-        let mut sim = HeadlessSim::new(config);
-        sim.run_for(5.0);
-        let summary = sim.summary(0.0);
-        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
-        summary.levels_mean[Lod::Rigid]
+        rigid_on_average_within_budget(config, 5.0)
     };
     let (at_figure, dearer) = (rigid_on_average(1.0), rigid_on_average(3.0));
     assert!(
@@ -166,11 +168,7 @@ fn with_a_least_benefit_per_cost_the_budget_is_a_ceiling_not_a_target() {
     let rigid_on_average = |least_benefit_per_ms: f32| {
         let mut config = budget_scene(20, 100.0);
         config.rules.budget.least_benefit_per_ms = least_benefit_per_ms;
-        let mut sim = HeadlessSim::new(config);
-        sim.run_for(10.0);
-        let summary = sim.summary(0.0);
-        assert_eq!(summary.budget.unwrap().decisions_over_budget, 0);
-        summary.levels_mean[Lod::Rigid]
+        rigid_on_average_within_budget(config, 10.0)
     };
     let (all, some) = (rigid_on_average(0.0), rigid_on_average(5.0));
     assert!(all > 19.0, "{all} rigid on average with no least benefit");
