@@ -265,12 +265,16 @@ impl Step {
     /// Sorts `steps` into the order they are taken, stably (so each creature's steps stay in
     /// the order of its hull): a radix sort by the ratio alone, then each run of equal ratios
     /// by serial. The radix sort then passes over four bytes of a key, not six or more, and in
-    /// a crowd's cheap steps (their ratios from the view) equal ratios are few.
+    /// a crowd's cheap steps (their ratios from the view) equal ratios are few; where they are
+    /// many (a crowd's free steps, to a hybrid that costs what its point mass does), a run is
+    /// radix-sorted too.
     fn sort(steps: &mut [Step]) {
         radsort::sort_by_key(steps, Step::descending_ratio);
         for run in steps.chunk_by_mut(|a, b| a.descending_ratio() == b.descending_ratio()) {
-            if run.len() > 1 {
-                run.sort_by_key(|s| s.serial);
+            match run.len() {
+                0 | 1 => {}
+                2..RADIX_SORTED_RUN => run.sort_by_key(|s| s.serial),
+                _ => radsort::sort_by_key(run, |s| s.serial),
             }
         }
     }
@@ -881,6 +885,9 @@ impl<S: Send> SettledAhead<S> {
         self.settled.pop_front().expect("the bound at the front was settled").1
     }
 }
+
+/// A run of steps of one ratio this long or longer is radix-sorted by serial ([`Step::sort`]).
+const RADIX_SORTED_RUN: usize = 256;
 
 /// A step needing over this share of the room the floors leave is dear ([`Listing`]): no more
 /// than this many such steps fit.
