@@ -626,6 +626,22 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         said.contains(&format!("within 10 % of its prediction in {honest}.")),
         "{said}"
     );
+    // The machine's own spread at each budget, as many times as a game has frames: a fixed job
+    // of about the budget (its median within a factor of three of it, whatever the machine's
+    // spells), its 99th percentile over its median in the report.
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("budget-scale.json")).unwrap()).unwrap();
+    let machine = json["summary"]["machine"].as_array().unwrap();
+    assert_eq!(machine.len(), 2, "{json}");
+    assert!(said.contains("timed 9 times"), "{said}");
+    for (m, budget) in machine.iter().zip([0.4, 3.0]) {
+        let figure = |name: &str| m[name].as_f64().unwrap();
+        assert!((figure("budget_ms") - budget).abs() < 1e-6, "{m}");
+        assert!((budget / 3.0..budget * 3.0).contains(&figure("median_ms")), "{m}");
+        assert!(figure("p99_ms") >= figure("median_ms"), "{m}");
+        let row = format!("\n| {budget} | {:.2} |", figure("median_ms"));
+        assert!(said.contains(&row), "{row} in {said}");
+    }
     // Sizes out of order are refused with the field named.
     std::fs::write(
         &file,

@@ -13,8 +13,11 @@ use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings, p99_ms, timed_frames};
 use crate::bench::scaled;
 use simlod::config::{SimConfig, Validate, Validator};
+use simlod::contract::threads_for;
 use simlod::headless::HeadlessSim;
 use simlod::lod::{BudgetTally, LevelPolicy, Lod};
+use simlod::{PARALLEL_MIN_CREATURES, run_chunks};
+use std::time::Instant;
 
 /// `assets/experiments/budget_scale.ron`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -142,6 +145,64 @@ fn game(config: &SimConfig, s: &BudgetScaleSettings, creatures: u32, budget_ms: 
     }
 }
 
+/// The machine's own spread at one budget: a fixed job on each of the compute pool's threads (as
+/// a crowd's stages run), its length set to about the budget, timed as many times as a game has
+/// frames. Where its 99th percentile is over 1.25 times its median, no game that spends the
+/// budget keeps its 99th percentile within 25 % of it on this machine, whatever the policy.
+#[derive(Clone, Debug, Serialize)]
+struct MachineSpread {
+    budget_ms: f32,
+    median_ms: f64,
+    mean_ms: f64,
+    p99_ms: f64,
+}
+
+impl MachineSpread {
+    fn p99_over_median(&self) -> f64 {
+        self.p99_ms / self.median_ms
+    }
+}
+
+/// `steps` dependent multiply-adds on each of the compute pool's threads (one outside an app).
+fn fixed_job(steps: u64) {
+    let threads = threads_for(PARALLEL_MIN_CREATURES);
+    run_chunks((0..threads).map(|i| {
+        move || {
+            let mut x = 1.0 + i as f64;
+            for _ in 0..steps {
+                x = std::hint::black_box(x * 0.999_999_9 + 1e-9);
+            }
+        }
+    }));
+}
+
+/// The fixed job of about `budget_ms`, timed `frames` times. Its length is found first: doubled
+/// until a job takes half the budget, then scaled twice by the median of five (a job's start on
+/// the threads costs a little whatever its length).
+fn machine_spread(budget_ms: f32, frames: usize) -> MachineSpread {
+    let timed = |steps| {
+        let start = Instant::now();
+        fixed_job(steps);
+        start.elapsed().as_secs_f64()
+    };
+    let budget_s = f64::from(budget_ms) / 1e3;
+    let mut steps = 1024u64;
+    while timed(steps) < budget_s / 2.0 {
+        steps *= 2;
+    }
+    for _ in 0..2 {
+        let median_s = crate::bench::median((0..5).map(|_| timed(steps)).collect());
+        steps = ((steps as f64 * budget_s / median_s.max(1e-9)) as u64).max(1);
+    }
+    let times: Vec<f64> = (0..frames.max(1)).map(|_| timed(steps)).collect();
+    MachineSpread {
+        budget_ms,
+        median_ms: crate::bench::median(times.clone()) * 1e3,
+        mean_ms: times.iter().sum::<f64>() * 1e3 / times.len() as f64,
+        p99_ms: p99_ms(&times),
+    }
+}
+
 const HEADER: &str = "creatures,budget_ms,adaptive_frames,frames,mean_frame_ms,p99_frame_ms,predicted_mean_ms,decisions_over_budget,decisions,hybrid,rigid,warm_up_slowest_ms";
 
 /// Runs the experiment from `file`: every game, one at a time; writes its CSV, plot, JSON and
@@ -159,6 +220,9 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             }
         }
     }
+    // The machine's spread, after the games (so that their compute pool is the one measured).
+    let frames = games.first().map_or(1, |g| g.frames);
+    let machine: Vec<MachineSpread> = s.budgets_ms.iter().map(|&b| machine_spread(b, frames)).collect();
     drop(progress);
     let mut csv = format!("{HEADER}\n");
     for g in &games {
@@ -183,8 +247,8 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     ExperimentRecord {
         experiment: "budget-scale".into(),
         command: command("budget-scale", options),
-        summary: serde_json::json!({ "games": games }),
-        report: report(&games, &s),
+        summary: serde_json::json!({ "games": games, "machine": machine }),
+        report: report(&games, &machine, &s),
         smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
@@ -238,7 +302,7 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
     Ok(())
 }
 
-fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
+fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) -> String {
     // The frames a game holds after its warm-up, and which of them, slowest first, is its 99th
     // percentile: the slowest of all in a game under 100 frames.
     let frames = games.first().map_or(0, |g| g.frames);
@@ -289,5 +353,24 @@ fn report(games: &[Game], s: &BudgetScaleSettings) -> String {
         "\nKept in {kept} of {} games; the mean frame within 10 % of its prediction in {honest}.\n",
         games.len()
     );
+    let _ = write!(
+        report,
+        "\nThe machine's own spread: a fixed job of about each budget on every core, timed {} times (as many as a game's \
+         frames). Where its 99th percentile is over 1.25 times its median, no game that spends the budget keeps its 99th \
+         percentile within 25 % of it on this machine, whatever the policy.\n\n\
+         | budget (ms) | median (ms) | mean (ms) | 99th percentile (ms) | 99th percentile / median |\n|---|---|---|---|---|\n",
+        frames
+    );
+    for m in machine {
+        let _ = writeln!(
+            report,
+            "| {} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            m.budget_ms,
+            m.median_ms,
+            m.mean_ms,
+            m.p99_ms,
+            m.p99_over_median()
+        );
+    }
     report
 }
