@@ -59,6 +59,14 @@ pub struct CameraRules {
     pub aim_toward_puck_fraction: f32,
     /// ... at this height (below the ice tilts the view down); -1000 to 1000 m.
     pub aim_height_m: f32,
+    /// Headless, the view's far plane: nothing deeper along the view is drawn (Bevy's camera
+    /// culls there, at 1000 m by default, as a file without it has); 1 to 1,000,000 m.
+    #[serde(default = "default_far_m")]
+    pub far_m: f32,
+}
+
+fn default_far_m() -> f32 {
+    1000.0
 }
 
 /// The `budget` policy (beyond the paper's conclusion: "cost/benefit heuristics might be
@@ -137,6 +145,7 @@ impl Validate for LevelRules {
             v.range("follow_height_m", c.follow_height_m, 0.1, 1000.0);
             v.within("aim_toward_puck_fraction", c.aim_toward_puck_fraction, 0.0, 1.0);
             v.range("aim_height_m", c.aim_height_m, -1000.0, 1000.0);
+            v.range("far_m", c.far_m, 1.0, 1_000_000.0);
         });
         v.range("release_margin_m", self.release_margin_m, 0.0, 1000.0);
         v.range("min_dwell_s", self.min_dwell_s, 0.0, 3600.0);

@@ -57,9 +57,9 @@ pub struct SimCamera {
     pub eye: Vec3,
     /// Unit view direction.
     pub forward: Vec3,
-    /// The frustum's left, right, bottom, top and near half-spaces: `(n, w)` holds the points
-    /// `p` with `n . p + w >= 0`, `n` a unit vector. The far plane is at infinity.
-    pub frustum: [Vec4; 5],
+    /// The frustum's left, right, bottom, top, near and far half-spaces: `(n, w)` holds the
+    /// points `p` with `n . p + w >= 0`, `n` a unit vector.
+    pub frustum: [Vec4; 6],
     /// How fast the view turns, radians per second: a creature a switch keeps waiting for
     /// its flight window may be swept into view meanwhile.
     pub turn_rate_rad_per_s: f32,
@@ -69,19 +69,26 @@ pub struct SimCamera {
 
 impl SimCamera {
     /// The camera whose projection and view give `clip_from_world`, with its eye at
-    /// `world_from_view`'s origin (Gribb and Hartmann's planes, for Bevy's reversed depth).
-    pub fn new(clip_from_world: Mat4, world_from_view: Mat4, following: Option<Entity>) -> Self {
+    /// `world_from_view`'s origin (Gribb and Hartmann's planes, for Bevy's reversed depth), and
+    /// its far plane `far_m` deep along the view, where Bevy culls (its projections' depth
+    /// has no far plane: infinite reversed depth).
+    pub fn new(clip_from_world: Mat4, world_from_view: Mat4, far_m: f32, following: Option<Entity>) -> Self {
         let row = |i| clip_from_world.row(i);
         let half_space = |h: Vec4| h / h.truncate().length().max(f32::MIN_POSITIVE);
+        let (eye, forward) = (
+            world_from_view.w_axis.truncate(),
+            -world_from_view.z_axis.truncate().normalize_or(Vec3::NEG_Z),
+        );
         Self {
-            eye: world_from_view.w_axis.truncate(),
-            forward: -world_from_view.z_axis.truncate().normalize_or(Vec3::NEG_Z),
+            eye,
+            forward,
             frustum: [
                 half_space(row(3) + row(0)),
                 half_space(row(3) - row(0)),
                 half_space(row(3) + row(1)),
                 half_space(row(3) - row(1)),
                 half_space(row(3) - row(2)),
+                (-forward).extend(far_m + forward.dot(eye)),
             ],
             turn_rate_rad_per_s: 0.0,
             following,
@@ -96,17 +103,22 @@ impl SimCamera {
         self
     }
 
-    /// A perspective camera at `eye` looking at `aim`, as Bevy's (near plane 0.1 m).
+    /// A perspective camera at `eye` looking at `aim`, as Bevy's (near plane 0.1 m, far plane
+    /// `far_m`).
     pub fn looking_at(
         eye: Vec3,
         aim: Vec3,
-        vertical_fov_rad: f32,
-        aspect_ratio: f32,
+        (vertical_fov_rad, aspect_ratio, far_m): (f32, f32, f32),
         following: Option<Entity>,
     ) -> Self {
         let view_from_world = Mat4::look_at_rh(eye, aim, Vec3::Y);
         let clip_from_view = Mat4::perspective_infinite_reverse_rh(vertical_fov_rad, aspect_ratio, 0.1);
-        Self::new(clip_from_view * view_from_world, view_from_world.inverse(), following)
+        Self::new(
+            clip_from_view * view_from_world,
+            view_from_world.inverse(),
+            far_m,
+            following,
+        )
     }
 
     /// Whether any of the sphere at `centre` of `radius` is in view.
@@ -369,8 +381,7 @@ fn place_camera(
             state.position.lerp(puck.position, c.aim_toward_puck_fraction),
             c.aim_height_m,
         ),
-        c.field_of_view_deg.to_radians(),
-        c.aspect_ratio,
+        (c.field_of_view_deg.to_radians(), c.aspect_ratio, c.far_m),
         Some(entity),
     );
     *camera = placed.turned_since(&camera, 1.0 / clock.tick_hz as f32);
@@ -527,8 +538,7 @@ mod tests {
         let camera = SimCamera::looking_at(
             Vec3::new(0.0, 1.5, 0.0),
             Vec3::new(10.0, 1.5, 0.0),
-            90f32.to_radians(),
-            1.0,
+            (90f32.to_radians(), 1.0, 2000.0),
             None,
         );
         let side = |z: f32| Vec3::new(10.0, 1.5, z);
@@ -543,6 +553,11 @@ mod tests {
         assert!(!camera.sees(Vec3::new(10.0, -9.0, 0.0), 0.0));
         assert!(!camera.sees(Vec3::new(-1.0, 1.5, 0.0), 0.5));
         assert!(camera.sees(Vec3::new(1000.0, 1.5, 0.0), 0.0));
+        // Beyond the far plane, as the renderer culls: 2,000 m deep along the view, wherever
+        // across it.
+        assert!(camera.sees(Vec3::new(1999.0, 1.5, 1500.0), 0.0));
+        assert!(!camera.sees(Vec3::new(2001.0, 1.5, 1500.0), 0.0));
+        assert!(camera.sees(Vec3::new(2001.0, 1.5, 0.0), 1.5));
         // A default camera sees everything.
         assert!(SimCamera::default().sees(Vec3::new(-1e4, 5.0, 3.0), 0.0));
     }

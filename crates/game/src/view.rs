@@ -86,7 +86,13 @@ fn share_view(
     let (transform, projection) = *camera;
     let world_from_view = transform.to_matrix();
     let clip_from_world = projection.get_clip_from_view() * world_from_view.inverse();
-    let shared = SimCamera::new(clip_from_world, world_from_view, round.player).turned_since(&view, time.delta_secs());
+    let far_m = match projection {
+        Projection::Perspective(p) => p.far,
+        Projection::Orthographic(p) => p.far,
+        Projection::Custom(_) => f32::INFINITY,
+    };
+    let shared =
+        SimCamera::new(clip_from_world, world_from_view, far_m, round.player).turned_since(&view, time.delta_secs());
     view.set_if_neq(shared);
 }
 
