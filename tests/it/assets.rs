@@ -452,6 +452,13 @@ fn absurd_sizes_masses_speeds_and_rates_are_refused_with_the_unit() {
             "0 and 60 s",
         ),
         (
+            "rules/levels.ron",
+            "far_m: 1000.0,",
+            "far_m: 0.0,",
+            "camera.far_m",
+            "between 1 and 1e6 m, got 0",
+        ),
+        (
             "gaits/hopper.ron",
             "sample_hz: 30.0",
             "sample_hz: 1e9",
