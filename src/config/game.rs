@@ -46,6 +46,10 @@ pub struct FrameBudgetInGame {
     /// corrects the cost model by its measured frames, smoothed over this many; 0 leaves it
     /// off. 0 to 10,000 frames.
     pub adaptive_frames: f32,
+    /// With it, the percentile of those frames the game keeps within the budget (see the
+    /// rules' `budget.adaptive_percentile`); 0, as a file without it, their mean.
+    #[serde(default)]
+    pub adaptive_percentile: f32,
     /// Whether the game measures the cost model on the machine that plays before its window
     /// opens (a second or two), in place of the file's, for the whole session. A file without
     /// it leaves the file's model.
@@ -59,6 +63,7 @@ impl FrameBudgetInGame {
     pub fn apply(&self, rules: &mut super::LevelRules) {
         if rules.budget.adaptive_frames == 0.0 {
             rules.budget.adaptive_frames = self.adaptive_frames;
+            rules.budget.adaptive_percentile = self.adaptive_percentile;
         }
     }
 }
@@ -278,6 +283,7 @@ impl Validate for GameConfig {
         });
         v.nested("frame_budget", |v| {
             v.within("adaptive_frames", self.frame_budget.adaptive_frames, 0.0, 10_000.0);
+            super::validate_adaptive_percentile(v, "adaptive_percentile", self.frame_budget.adaptive_percentile);
         });
         let k = &self.creature_look;
         v.nested("creature_look", |v| {

@@ -126,6 +126,19 @@ pub struct BudgetRules {
     /// 0 (the default) has none; else 1 to 100.
     #[serde(default)]
     pub emergency_over: f32,
+    /// 0 (the default): the adaptive mode keeps the mean frame at the budget. 50 to 100: it
+    /// keeps this percentile of the last `adaptive_frames` frames within it, so that a slow
+    /// frame is as rare as that says, not only the mean right: on a machine whose frames
+    /// vary, the mean then sits under the budget by as much as they vary.
+    #[serde(default)]
+    pub adaptive_percentile: f32,
+}
+
+/// The adaptive mode's percentile, in the rules or the game's file: 0 (the mean) or 50 to 100.
+pub fn validate_adaptive_percentile(v: &mut Validator, field: &str, p: f32) {
+    if !(p == 0.0 || (50.0..=100.0).contains(&p)) {
+        v.fail(field, format!("must be 0 (the mean) or between 50 and 100, got {p}"));
+    }
 }
 
 impl Validate for LevelRules {
@@ -179,6 +192,7 @@ impl Validate for LevelRules {
                     format!("must be 0 (none) or between 1 and 100, got {e}"),
                 );
             }
+            validate_adaptive_percentile(v, "adaptive_percentile", b.adaptive_percentile);
         });
         let (a, b) = self.flight_window;
         v.range("flight_window.0", a, 0.0, 1.0);

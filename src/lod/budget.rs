@@ -24,6 +24,7 @@
 use bevy::prelude::*;
 use serde::Serialize;
 use std::cell::Cell;
+use std::collections::VecDeque;
 
 use super::select::{
     Area, DecisionInputs, LevelChoice, SimCamera, ViewReach, areas_now, select_levels, start_at_selected_levels,
@@ -1004,7 +1005,7 @@ impl Floors {
 /// measured over the predicted time, smoothed over about `frames` frames. A ratio beyond 10
 /// either way (a stalled frame) counts as 10. A frame measured over `emergency_us` (the
 /// emergency tier) sets the correction at once to its own ratio, where that is higher.
-pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32, emergency_us: f32) -> f32 {
+fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32, emergency_us: f32) -> f32 {
     if model_us <= 0.0 || !measured_us.is_finite() {
         return correction;
     }
@@ -1017,6 +1018,36 @@ pub fn corrected(correction: f32, model_us: f32, measured_us: f32, frames: f32, 
     }
 }
 
+/// The percentile mode's last frames: what each took beyond its corrected prediction (us),
+/// oldest first.
+#[derive(Clone, Debug, Default)]
+pub struct RecentFrames {
+    excess_us: VecDeque<f32>,
+    ranked: Vec<f32>,
+}
+
+impl RecentFrames {
+    /// Adds `excess_us` to the last `frames` and gives their `percentile` by nearest rank
+    /// (100: the highest).
+    pub fn percentile_with(&mut self, excess_us: f32, frames: usize, percentile: f32) -> f32 {
+        self.excess_us.push_back(excess_us);
+        while self.excess_us.len() > frames.max(1) {
+            self.excess_us.pop_front();
+        }
+        self.ranked.clear();
+        self.ranked.extend(&self.excess_us);
+        let at = nearest_rank(self.ranked.len(), percentile);
+        *self.ranked.select_nth_unstable_by(at, f32::total_cmp).1
+    }
+}
+
+/// Where the `percentile` (0 to 100) of `len` values lies among them sorted, by nearest rank:
+/// the smallest that as many hundredths of them are at or under (100: the highest).
+pub fn nearest_rank(len: usize, percentile: f32) -> usize {
+    let rank = (f64::from(percentile) / 100.0 * len as f64).ceil() as usize;
+    rank.clamp(1, len.max(1)) - 1
+}
+
 /// What the budget policy predicted, decision by decision (the summary and the HUD read it).
 #[derive(Resource, Clone, Debug)]
 pub struct BudgetTally {
@@ -1024,6 +1055,9 @@ pub struct BudgetTally {
     pub model_us: f32,
     /// The adaptive mode's measured over predicted time, smoothed; 1 when it is off.
     pub correction: f32,
+    /// The percentile mode's headroom: the rules' percentile of what the last frames took
+    /// beyond their corrected prediction, us, kept free of the budget (0 in the mean mode).
+    pub headroom_us: f32,
     /// The wall time the last frame's simulation took, per 1/30 s of motion (a decision's
     /// ticks), written from outside the simulation by whoever steps it (the game, the headless
     /// runner). Only the adaptive mode reads it. (Here and not a resource of its own: a new
@@ -1041,6 +1075,8 @@ pub struct BudgetTally {
     pub predicted_max_us: f32,
     /// Creatures searched for contacts with others, over all decisions.
     pub searched: u64,
+    /// The percentile mode's last frames.
+    pub recent: RecentFrames,
 }
 
 /// The budget policy's run, in the summary.
@@ -1064,6 +1100,9 @@ pub struct BudgetSummary {
     pub adaptive: bool,
     /// The adaptive mode's last correction, measured over predicted (1 when off).
     pub correction: f32,
+    /// What the adaptive mode kept at the budget: 0 the mean frame, else this percentile of
+    /// the last frames.
+    pub adaptive_percentile: f32,
 }
 
 impl Default for BudgetTally {
@@ -1071,21 +1110,65 @@ impl Default for BudgetTally {
         Self {
             model_us: 0.0,
             correction: 1.0,
+            headroom_us: 0.0,
             measured_us: None,
             decisions: 0,
             over_budget: 0,
             predicted_sum_us: 0.0,
             predicted_max_us: 0.0,
             searched: 0,
+            recent: RecentFrames::default(),
         }
     }
 }
 
 impl BudgetTally {
     /// The last decision's predicted simulation time of a frame: the cost model's, times the
-    /// adaptive correction.
+    /// adaptive correction, and in the percentile mode with its headroom (the frame at that
+    /// percentile).
     pub fn predicted_us(&self) -> f32 {
-        self.model_us * self.correction
+        self.model_us * self.correction + self.headroom_us
+    }
+
+    /// The budget of `budget_ms` as the cost model is to spend it: less the headroom, over the
+    /// correction.
+    fn model_budget_us(&self, budget_ms: f32) -> f32 {
+        (budget_ms * 1e3 - self.headroom_us).max(0.0) / self.correction
+    }
+
+    /// The adaptive mode after a frame: its measured time (taken, so that each frame counts
+    /// once) corrects the cost model toward the mean frame; in the percentile mode, what the
+    /// frame took beyond that prediction joins the last frames', whose percentile is kept free
+    /// of the budget. Frames that vary by a share of their work or by a stall alike then keep
+    /// that percentile within the budget, and a crowd at its floors is not held there by a
+    /// stall many times its small prediction.
+    fn correct(&mut self, rules: &BudgetRules) {
+        let Some(measured_us) = self.measured_us.take() else {
+            return;
+        };
+        if self.model_us <= 0.0 || !measured_us.is_finite() {
+            return;
+        }
+        let emergency_us = if rules.emergency_over > 0.0 {
+            rules.emergency_over * rules.frame_budget_ms * 1e3
+        } else {
+            f32::INFINITY
+        };
+        let predicted_us = self.model_us * self.correction;
+        self.correction = corrected(
+            self.correction,
+            self.model_us,
+            measured_us,
+            rules.adaptive_frames,
+            emergency_us,
+        );
+        if rules.adaptive_percentile > 0.0 {
+            self.headroom_us = self.recent.percentile_with(
+                measured_us - predicted_us,
+                rules.adaptive_frames as usize,
+                rules.adaptive_percentile,
+            );
+        }
     }
 
     /// The run so far under `rules`, as the summary reports it.
@@ -1099,6 +1182,7 @@ impl BudgetTally {
             searched_per_decision: self.searched as f64 / self.decisions.max(1) as f64,
             adaptive: rules.adaptive_frames > 0.0,
             correction: self.correction,
+            adaptive_percentile: rules.adaptive_percentile,
         }
     }
 
@@ -1699,10 +1783,9 @@ fn scene<'a>(
 }
 
 impl DecisionInputs<'_, '_> {
-    /// The allocation for every creature now, in the query's order: within the budget as the
-    /// cost model predicts it, times `correction`.
-    fn decide(&self, creatures: &Creatures, correction: f32) -> Allocation<f32> {
-        let budget_us = self.config.rules.budget.frame_budget_ms * 1e3 / correction;
+    /// The allocation for every creature now, in the query's order: within `budget_us` as the
+    /// cost model predicts it.
+    fn decide(&self, creatures: &Creatures, budget_us: f32) -> Allocation<f32> {
         let scene = scene(
             &self.config,
             &self.kinds,
@@ -1729,23 +1812,10 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
         return;
     }
     let rules = &inputs.config.rules.budget;
-    if rules.adaptive_frames > 0.0
-        && let Some(measured_us) = tally.measured_us
-    {
-        let emergency_us = if rules.emergency_over > 0.0 {
-            rules.emergency_over * rules.frame_budget_ms * 1e3
-        } else {
-            f32::INFINITY
-        };
-        tally.correction = corrected(
-            tally.correction,
-            tally.model_us,
-            measured_us,
-            rules.adaptive_frames,
-            emergency_us,
-        );
+    if rules.adaptive_frames > 0.0 {
+        tally.correct(rules);
     }
-    let decision = inputs.decide(&creatures, tally.correction);
+    let decision = inputs.decide(&creatures, tally.model_budget_us(rules.frame_budget_ms));
     tally.record(&decision);
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
@@ -1761,7 +1831,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
 pub fn choice_now(world: &mut World) -> Option<Allocation<f32>> {
     let mut state = bevy::ecs::system::SystemState::<(DecisionInputs, Creatures)>::new(world);
     let (inputs, creatures) = state.get_mut(world).ok()?;
-    Some(inputs.decide(&creatures, 1.0))
+    Some(inputs.decide(&creatures, inputs.config.rules.budget.frame_budget_ms * 1e3))
 }
 
 /// A new world under the budget policy: its creatures, placed at the cheapest level, start at
@@ -1778,7 +1848,10 @@ fn start_by_budget(
         return;
     }
     let now = inputs.clock.seconds() as f32;
-    let decision = inputs.decide(&creatures, tally.correction);
+    let decision = inputs.decide(
+        &creatures,
+        tally.model_budget_us(inputs.config.rules.budget.frame_budget_ms),
+    );
     let mut searched = decision.settled.iter().peekable();
     for (row, ((entity, c, &lod, _, mut choice), &level)) in creatures.iter_mut().zip(&decision.levels).enumerate() {
         if level != lod
@@ -2471,6 +2544,31 @@ mod tests {
         assert!((smoothed - (1.0 + 0.4 / 30.0)).abs() < 1e-6, "{smoothed}");
         // An emergency never lowers a correction already above its frame's ratio.
         assert_eq!(corrected(4.0, 1000.0, 3000.0, 30.0, 1500.0), 4.0 - 1.0 / 30.0);
+    }
+
+    #[test]
+    fn the_percentile_mode_keeps_that_rank_among_the_last_frames_only() {
+        let mut recent = RecentFrames::default();
+        // Excesses 1, 2, ..., 100 us: the 99th percentile of the 100 is 99, the 50th 50.
+        let mut last = 0.0;
+        for r in 1..=100 {
+            last = recent.percentile_with(r as f32, 100, 99.0);
+        }
+        assert_eq!(last, 99.0);
+        assert_eq!(
+            recent.clone().percentile_with(100.0, 100, 50.0),
+            51.0,
+            "1 left the window"
+        );
+        // 100 frames of 1 push the old ones out: one slow frame in a hundred is the 100th
+        // percentile, not the 99th.
+        for _ in 0..99 {
+            recent.percentile_with(1.0, 100, 99.0);
+        }
+        assert_eq!(recent.percentile_with(5.0, 100, 99.0), 1.0);
+        assert_eq!(recent.clone().percentile_with(1.0, 100, 100.0), 5.0);
+        // A shorter window keeps only the newest.
+        assert_eq!(recent.percentile_with(1.0, 1, 100.0), 1.0);
     }
 
     #[test]

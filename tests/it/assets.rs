@@ -179,6 +179,25 @@ fn an_emergency_line_under_the_budget_is_refused() {
 }
 
 #[test]
+fn a_percentile_under_the_median_for_the_adaptive_mode_is_refused() {
+    let err = load_error(
+        "adaptive_percentile",
+        "rules/levels.ron",
+        &edited(
+            "rules/levels.ron",
+            "adaptive_percentile: 0.0",
+            "adaptive_percentile: 20.0",
+        ),
+    );
+    assert_names(
+        &err,
+        "rules/levels.ron",
+        "budget.adaptive_percentile",
+        "must be 0 (the mean) or between 50 and 100, got 20",
+    );
+}
+
+#[test]
 fn a_nan_is_refused() {
     let err = load_error(
         "nan",

@@ -343,6 +343,41 @@ fn the_adaptive_mode_spends_less_where_frames_measure_dearer_than_the_cost_model
 }
 
 #[test]
+fn the_percentile_mode_keeps_that_share_of_the_frames_within_the_budget_not_their_mean() {
+    let budget_ms = 0.6;
+    let mut config = budget_scene(30, budget_ms);
+    config.rules.budget.adaptive_frames = 30.0;
+    // One frame in five measures three times what the cost model predicted, the rest as
+    // predicted.
+    let spiky = |t: &BudgetTally| if t.decisions.is_multiple_of(5) { 3.0 } else { 1.0 } * t.model_us;
+    let run = |percentile: f32| {
+        let mut config = config.clone();
+        config.rules.budget.adaptive_percentile = percentile;
+        let mut sim = with_frames_measured(config, 6.0, spiky);
+        let tally = sim.app.world().resource::<BudgetTally>().clone();
+        (tally, sim.summary(0.0).levels_mean[Lod::Rigid])
+    };
+    // The correction follows the mean frame, about 1.4 times the model, either way.
+    let (mean, rigid_mean) = run(0.0);
+    let (p90, rigid_p90) = run(90.0);
+    for tally in [&mean, &p90] {
+        assert!((1.2..1.7).contains(&tally.correction), "{tally:?}");
+    }
+    // The 90th percentile of the last 30 frames is a slow one: what it took beyond the mean is
+    // kept free, so that the slow frames too fit the budget. It buys fewer rigid creatures.
+    assert_eq!(mean.headroom_us, 0.0);
+    assert!(p90.headroom_us > 0.0, "{p90:?}");
+    assert!(p90.predicted_us() <= budget_ms * 1e3 + 1e-3, "{p90:?}");
+    assert!(
+        rigid_p90 < rigid_mean,
+        "rigid on average: {rigid_p90} keeping the 90th percentile, {rigid_mean} the mean"
+    );
+    // Their median is a frame as predicted, under the mean: it leaves room for more.
+    let (p50, _) = run(50.0);
+    assert!(p50.headroom_us < 0.0, "{p50:?}");
+}
+
+#[test]
 fn in_the_adaptive_mode_a_frame_far_over_the_budget_cuts_the_next_decision_at_once() {
     let budget_ms = 0.6;
     let mut config = budget_scene(30, budget_ms);

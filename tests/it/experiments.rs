@@ -573,55 +573,62 @@ fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
 fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys_more_with_more() {
     let dir = scratch_dir("budget_scale");
     let file = dir.join("budget_scale.ron");
-    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], seconds: 0.4, warm_up_s: 0.1, seed: 3)";
+    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], adaptive_percentiles: [0.0, 99.0], seconds: 0.4, warm_up_s: 0.1, seed: 3)";
     std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
     let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
     every_file_it_says_it_wrote_exists(&said, &dir);
     let rows = table(&dir.join("budget-scale.csv"));
-    let games: Vec<(&str, &str, &str)> = rows[1..]
-        .iter()
-        .map(|r| (r[0].as_str(), r[1].as_str(), r[2].as_str()))
+    let games: Vec<[&str; 4]> = (rows[1..].iter())
+        .map(|r| [0, 1, 2, 3].map(|i| r[i].as_str()))
         .collect();
     let mut want = Vec::new();
     for n in ["30", "90"] {
         for b in ["0.4", "3"] {
-            for a in ["0", "20"] {
-                want.push((n, b, a));
+            // The cost model alone once; the adaptive mode keeping the mean, then the 99th
+            // percentile.
+            for (a, p) in [("0", "0"), ("20", "0"), ("20", "99")] {
+                want.push([n, b, a, p]);
             }
         }
     }
     assert_eq!(games, want);
     // Each game's figures are of its frames after the warm-up; the warm-up's slowest is apart.
+    // The frame predicted is the mean, or where a percentile is kept, that percentile (of 9
+    // frames, the 99th is the slowest).
+    let number = |r: &Vec<String>, i: usize| r[i].parse::<f64>().unwrap();
     for r in &rows[1..] {
-        assert_eq!(r[3], "9", "{r:?}");
-        assert!(r[11].parse::<f64>().unwrap() > 0.0, "{r:?}");
+        assert_eq!(r[4], "9", "{r:?}");
+        assert!(number(r, 13) > 0.0, "{r:?}");
+        let held = if r[3] == "99" { 6 } else { 5 };
+        assert_eq!(r[7], r[held], "{r:?}");
     }
     assert!(said.contains("The first 0.1 s of each game"), "{said}");
     // The cost model alone is reproducible: a larger budget buys more rigid creatures.
     let rigid = |n: &str, b: &str| {
         let r = rows.iter().find(|r| r[0] == n && r[1] == b && r[2] == "0").unwrap();
-        r[10].parse::<f64>().unwrap()
+        number(r, 12)
     };
     assert!(rigid("90", "3") > rigid("90", "0.4"), "{rows:?}");
     assert_eq!(
         said.matches("\n| 30 |").count() + said.matches("\n| 90 |").count(),
-        8,
+        12,
         "{said}"
     );
-    assert!(said.contains("of 8 games"), "{said}");
-    // Each game's mean over its prediction, in its row in the games' order, and how many were
-    // within 10 % of it either way.
+    assert!(said.contains("of 12 games"), "{said}");
+    assert!(said.contains("| 20 frames, 99th percentile |"), "{said}");
+    // Each game's frame predicted over its prediction, in its row in the games' order, and how
+    // many were within 10 % of it either way.
     let reported: Vec<f64> = (said.lines())
         .filter(|l| l.starts_with("| 30 |") || l.starts_with("| 90 |"))
         .map(|l| l.split('|').nth(7).unwrap().trim().parse().unwrap())
         .collect();
     let mut honest = 0;
     for (r, reported) in rows[1..].iter().zip(&reported) {
-        let ratio = r[4].parse::<f64>().unwrap() / r[6].parse::<f64>().unwrap();
+        let ratio = number(r, 7) / number(r, 8);
         assert!((reported - ratio).abs() < 0.006, "{reported} for {r:?}");
         honest += usize::from((ratio - 1.0).abs() <= 0.1);
     }
-    assert_eq!(reported.len(), 8, "{said}");
+    assert_eq!(reported.len(), 12, "{said}");
     assert!(
         said.contains(&format!("within 10 % of its prediction in {honest}.")),
         "{said}"
@@ -642,23 +649,15 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         let row = format!("\n| {budget} | {:.2} |", figure("median_ms"));
         assert!(said.contains(&row), "{row} in {said}");
     }
-    // Sizes out of order are refused with the field named.
-    std::fs::write(
-        &file,
-        format!("(full: {0}, quick: {0})", settings.replace("[30, 90]", "[90, 30]")),
-    )
-    .unwrap();
-    let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
-    assert!(err.to_string().contains("creatures"), "{err}");
-    // So is a warm-up as long as the game.
-    std::fs::write(
-        &file,
-        format!(
-            "(full: {0}, quick: {0})",
-            settings.replace("warm_up_s: 0.1", "warm_up_s: 0.4")
-        ),
-    )
-    .unwrap();
-    let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
-    assert!(err.to_string().contains("warm_up_s"), "{err}");
+    // Settings out of range are refused with the field named: sizes out of order, a warm-up as
+    // long as the game, a percentile under 50.
+    for (from, to, named) in [
+        ("[30, 90]", "[90, 30]", "creatures"),
+        ("warm_up_s: 0.1", "warm_up_s: 0.4", "warm_up_s"),
+        ("99.0]", "30.0]", "adaptive_percentiles[1]`: must be 0"),
+    ] {
+        std::fs::write(&file, format!("(full: {0}, quick: {0})", settings.replace(from, to))).unwrap();
+        let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();
+        assert!(err.to_string().contains(named), "{err}");
+    }
 }

@@ -432,10 +432,19 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     let root = copy_assets("game_adaptive_budget");
     let mut app = watching_app(&root);
     let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
-    assert_eq!(looks.frame_budget.adaptive_frames, 30.0, "as shipped");
+    let shipped = &looks.frame_budget;
+    assert_eq!(
+        (shipped.adaptive_frames, shipped.adaptive_percentile),
+        (30.0, 99.0),
+        "as shipped"
+    );
     app.insert_resource(GameSettings(looks.clone()));
     let_the_first_loads_settle(&mut app);
-    let adaptive = |app: &App| running_and_next(app, |c| c.rules.budget.adaptive_frames);
+    let adaptive = |app: &App| {
+        running_and_next(app, |c| {
+            (c.rules.budget.adaptive_frames, c.rules.budget.adaptive_percentile)
+        })
+    };
     // An edit of the rules (which leave the adaptive mode off) runs with the game's.
     let (rules_file, game_file) = (root.join("rules/levels.ron"), root.join("game.ron"));
     assert!(
@@ -447,13 +456,19 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
-    assert_eq!(adaptive(&app), [30.0; 2]);
+    assert_eq!(adaptive(&app), [(30.0, 99.0); 2]);
     // The game's setting edited: at once, running and for the next rounds.
     edit(&game_file, "adaptive_frames: 30.0", "adaptive_frames: 0.0");
+    edit(&game_file, "adaptive_percentile: 99.0", "adaptive_percentile: 0.0");
     update_until(&mut app, "the game file's edit", |app| {
-        app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 0.0
+        app.world()
+            .resource::<GameSettings>()
+            .0
+            .frame_budget
+            .adaptive_percentile
+            == 0.0
     });
-    assert_eq!(adaptive(&app), [0.0; 2]);
+    assert_eq!(adaptive(&app), [(0.0, 0.0); 2]);
     // Rules that set their own adaptive mode keep it whatever the game says.
     edit(&rules_file, "adaptive_frames: 0.0,", "adaptive_frames: 12.0,");
     update_until(&mut app, "the rules' own adaptive mode", |app| {
@@ -463,7 +478,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the second game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
     });
-    assert_eq!(adaptive(&app), [12.0; 2]);
+    assert_eq!(adaptive(&app), [(12.0, 0.0); 2]);
 }
 
 #[test]

@@ -144,8 +144,12 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
             )
         };
         let adaptive = if b.adaptive {
+            let keeps = match b.adaptive_percentile {
+                0.0 => String::new(),
+                p => format!(" keeping the {p}th percentile of the frames within the budget"),
+            };
             format!(
-                " (adaptive, not reproducible: the cost model corrected x {:.2} at the end)",
+                " (adaptive{keeps}, not reproducible: the cost model corrected x {:.2} at the end)",
                 b.correction
             )
         } else {

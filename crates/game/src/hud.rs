@@ -252,7 +252,11 @@ fn stats_text(
             budget.predicted_us() / 1e3,
             timing.sim_ms_per_decision,
             if rules.budget.adaptive_frames > 0.0 {
-                format!("   adaptive: model x {:.2}", budget.correction)
+                let keeps = match rules.budget.adaptive_percentile {
+                    0.0 => String::new(),
+                    p => format!(" ({p}th percentile)"),
+                };
+                format!("   adaptive{keeps}: model x {:.2}", budget.correction)
             } else {
                 String::new()
             },

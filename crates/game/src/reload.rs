@@ -287,8 +287,10 @@ fn apply_looks(
     {
         let mut rules = files.clone();
         new.frame_budget.apply(&mut rules);
-        base.rules.budget.adaptive_frames = rules.budget.adaptive_frames;
-        live.rules.budget.adaptive_frames = rules.budget.adaptive_frames;
+        for budget in [&mut base.rules.budget, &mut live.rules.budget] {
+            budget.adaptive_frames = rules.budget.adaptive_frames;
+            budget.adaptive_percentile = rules.budget.adaptive_percentile;
+        }
     }
     settings.0 = new.clone();
 }

@@ -324,10 +324,17 @@ pub fn log10_span(creatures: &[u32]) -> (f64, f64) {
 
 /// The 99th percentile of frame times given in seconds, in ms.
 pub fn p99_ms(frames_s: &[f64]) -> f64 {
+    percentile_ms(frames_s, 99.0)
+}
+
+/// The `percentile` of frame times given in seconds (by nearest rank, as the adaptive mode
+/// takes it), in ms; 0 without any.
+pub fn percentile_ms(frames_s: &[f64], percentile: f32) -> f64 {
     let mut sorted = frames_s.to_vec();
     sorted.sort_by(f64::total_cmp);
-    let at = (sorted.len() as f64 * 0.99).ceil() as usize;
-    sorted.get(at.saturating_sub(1)).map_or(0.0, |s| s * 1e3)
+    sorted
+        .get(simlod::lod::nearest_rank(sorted.len(), percentile))
+        .map_or(0.0, |s| s * 1e3)
 }
 
 /// The median of some values (NaN if there are none).
