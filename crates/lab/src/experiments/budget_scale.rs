@@ -29,7 +29,7 @@ pub struct BudgetScaleSettings {
     /// The frame budgets, ms of simulation per 1/30 s.
     pub budgets_ms: Vec<f32>,
     /// The adaptive mode's settings: 0 is the cost model alone; above, the frames over which
-    /// the correction by measured frames is smoothed.
+    /// the correction by measured frames is smoothed (and the percentile taken).
     pub adaptive_frames: Vec<f32>,
     /// What each adaptive setting above 0 keeps at the budget, each a game: 0 the mean frame,
     /// 50 to 100 that percentile of the frames (a file without it: the mean only).
@@ -118,7 +118,7 @@ struct Game {
     mean_frame_ms: f64,
     p99_frame_ms: f64,
     /// The frame the prediction is of: the mean, or in the percentile mode that percentile
-    /// (whose measured over predicted ratio the correction is).
+    /// (the cost model's prediction, corrected by the mean, with its headroom).
     held_frame_ms: f64,
     predicted_mean_ms: f64,
     /// Decisions where even the cheapest levels allowed were predicted over the budget.
@@ -402,8 +402,8 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) ->
          The budget is kept where the mean frame is no more than 10 % over it and the 99th percentile no more than 25 % over: a game is {frames} frames \
          after its warm-up, and its 99th percentile is {p99_is}. \
          Measured / predicted: the frame predicted over its prediction, honest within 10 % either way: the mean frame, or where \
-         the adaptive mode keeps a percentile of the frames at the budget, that percentile (its prediction is the cost model's \
-         times that percentile of the last frames' measured over predicted). \
+         the adaptive mode keeps a percentile of the frames at the budget, that percentile (its prediction is the cost model's, \
+         corrected by the mean, with that percentile of what the last frames took beyond it kept free). \
          Over budget: the decisions where even the cheapest levels were predicted over it.\n\n\
          | creatures | budget (ms) | adaptive | mean frame (ms) | 99th percentile (ms) | predicted (ms) | measured / predicted | kept | over budget | hybrid | rigid | warm-up's slowest (ms) |\n\
          |---|---|---|---|---|---|---|---|---|---|---|---|\n",
@@ -432,7 +432,7 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) ->
     let honest = games.iter().filter(|g| g.predicted_within_10_percent()).count();
     let _ = write!(
         report,
-        "\nKept in {kept} of {} games; the mean frame within 10 % of its prediction in {honest}.\n",
+        "\nKept in {kept} of {} games; the frame predicted within 10 % of its prediction in {honest}.\n",
         games.len()
     );
     let _ = write!(
