@@ -116,8 +116,11 @@ fn inertialize(x0: f32, v0: f32, t1: f32, t: f32) -> f32 {
     (((((a * t + b) * t + c) * t + a0 / 2.0) * t + v0) * t) + x0
 }
 
-/// A creature's drawing is blended from its old level's motion into its new one's.
+/// A creature's drawing is blended from its old level's motion into its new one's. Stored
+/// apart from the creatures' tables (as is [`SwitchProbe`]): a blend comes and goes with each
+/// switch, and in a table its coming and going moved the creature's whole row, twice.
 #[derive(Component, Clone, Copy, Debug)]
+#[component(storage = "SparseSet")]
 pub struct SwitchBlend {
     offset: [f32; CHANNELS],
     offset_rate: [f32; CHANNELS],
@@ -154,15 +157,15 @@ pub fn drawn(state: &PlanarState, pose: &GaitPose, blend: Option<&SwitchBlend>, 
 #[derive(Component, Clone, Copy, Debug, Default)]
 pub struct DrawnBefore(pub Option<(Drawn, Drawn)>);
 
-/// A switch being measured over its first `PROBE_TICKS` ticks.
+/// A switch being measured over its first `PROBE_TICKS` ticks (stored apart, as a blend is).
 #[derive(Component, Clone, Copy, Debug)]
+#[component(storage = "SparseSet")]
 pub struct SwitchProbe {
     /// The level left.
     pub from: Lod,
     /// The level entered.
     pub to: Lod,
-    /// Whether the switch did not wait for the flight window: a collision forced it, or a
-    /// point mass switched off screen.
+    /// Whether a collision forced the switch, without waiting for the flight window.
     pub forced: bool,
     /// Drawn (and by the models alone) two ticks and one tick before the switch.
     before: [Drawn; 2],
@@ -285,8 +288,7 @@ pub struct PopSummary {
     pub from: &'static str,
     /// The level entered, by name.
     pub to: &'static str,
-    /// Whether these switches did not wait for the flight window (collisions, or point
-    /// masses off screen).
+    /// Whether collisions forced these switches, without waiting for the flight window.
     pub forced: bool,
     /// How many switches of this kind.
     pub count: usize,

@@ -44,6 +44,9 @@ pub struct LevelSwitched {
 pub struct SwitchTally {
     /// Switches by where they came from and went to.
     pub switches: SwitchCounts,
+    /// Of those, the switches off screen that no collision forced: not drawn, so neither
+    /// blended nor measured for their pop.
+    pub unseen: u64,
     /// Sums and peaks of the creatures at each level, sampled at each decision.
     pub level_sums: Counts<Lod, u64>,
     /// The most creatures at each level at any sampled decision.
@@ -75,9 +78,10 @@ fn switch_levels(
         &mut LevelChoice,
         &GaitPhase,
         &CollisionRecord,
-        (&PlanarState, &mut GaitPose, Option<&SwitchBlend>, &mut DrawnBefore),
+        (&PlanarState, &mut GaitPose, &mut DrawnBefore),
         &mut FrameStep,
     )>,
+    blends: Query<&SwitchBlend>,
 ) {
     let now = clock.seconds() as f32;
     let (open, close) = config.rules.flight_window;
@@ -110,14 +114,14 @@ fn switch_levels(
     }
     attend.sort_unstable();
     for entity in waiting.drain(..) {
-        if let Ok((_, _, &lod, choice, _, record, (_, _, _, mut before), _)) = creatures.get_mut(entity)
+        if let Ok((_, _, &lod, choice, _, record, (_, _, mut before), _)) = creatures.get_mut(entity)
             && !attends(lod, &choice, record)
         {
             before.0 = None;
         }
     }
     for &entity in attend.iter() {
-        let Ok((entity, creature, &lod, mut choice, gait, record, (state, mut pose, blend, mut before), mut frame)) =
+        let Ok((entity, creature, &lod, mut choice, gait, record, (state, mut pose, mut before), mut frame)) =
             creatures.get_mut(entity)
         else {
             continue;
@@ -144,10 +148,10 @@ fn switch_levels(
         }
         // What is drawn now (as the last tick left it), blended and by the model alone.
         let model = Drawn::of(state, &pose);
-        let seen = (blend.map_or(model, |b| b.apply(&model, now)), model);
+        let seen = (blends.get(entity).map_or(model, |b| b.apply(&model, now)), model);
         let progress = gait.flight_progress();
-        let unseen = lod == Lod::PointMass && !camera.shows(kind, state);
-        let skips_window = forced || unseen;
+        let unseen = !camera.shows(kind, state);
+        let skips_window = forced || (unseen && lod == Lod::PointMass);
         if !skips_window && !progress.is_some_and(|p| (open..=close).contains(&p)) {
             before.0 = Some(seen);
             waiting.push(entity);
@@ -163,10 +167,18 @@ fn switch_levels(
             };
             (back(seen.0), back(seen.1))
         });
-        commands.entity(entity).insert((
-            target,
-            SwitchProbe::new(lod, target, skips_window, [earlier.0, seen.0], [earlier.1, seen.1]),
-        ));
+        // A switch no one sees is neither blended nor measured for its pop: a crowd's point
+        // masses coming into the view's reach switch by the thousand in one frame, and the
+        // probe and the blend doubled what each cost.
+        if unseen && !forced {
+            commands.entity(entity).insert(target);
+            tally.unseen += 1;
+        } else {
+            commands.entity(entity).insert((
+                target,
+                SwitchProbe::new(lod, target, forced, [earlier.0, seen.0], [earlier.1, seen.1]),
+            ));
+        }
         tally.switches.count(lod, target);
         switched.write(LevelSwitched {
             creature: entity,

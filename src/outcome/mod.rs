@@ -193,7 +193,6 @@ type FramePlan<'a> = (
     &'a Clearance,
     &'a Lod,
     &'a LevelChoice,
-    Has<SwitchProbe>,
     Has<PlayerControlled>,
 );
 
@@ -215,6 +214,7 @@ fn plan_frames(
     camera: Res<SimCamera>,
     stepping: Option<Res<FrameStepping>>,
     mut creatures: Query<(FramePlan, &mut FrameStep), Without<AtRigid>>,
+    probed: Query<Entity, With<SwitchProbe>>,
 ) {
     // A frame of one or two ticks has nothing to gain.
     if !clock.is_decision_tick() || stepping.is_some_and(|s| !s.enabled) || clock.ticks_per_decision <= 2 {
@@ -241,9 +241,9 @@ fn plan_frames(
     // Every table's chunks in one scope (see `steer`).
     let mut tables: Vec<_> = creatures.contiguous_iter_mut().expect(DENSE).collect();
     let mut jobs = Vec::new();
-    for ((creature, state, record, clearance, lod, choice, probed, player), frame) in &mut tables {
+    for ((creature, state, record, clearance, lod, choice, player), frame) in &mut tables {
         let frame = frame.bypass_change_detection();
-        if *probed || *player {
+        if *player {
             frame.iter_mut().for_each(|f| f.behind = false);
             continue;
         }
@@ -261,8 +261,10 @@ fn plan_frames(
     }
     run_chunks(jobs.into_iter());
     drop(tables);
-    if let Some((_, mut frame)) = camera.following.and_then(|e| creatures.get_mut(e).ok()) {
-        frame.behind = false;
+    for entity in probed.iter().chain(camera.following) {
+        if let Ok((_, mut frame)) = creatures.get_mut(entity) {
+            frame.behind = false;
+        }
     }
 }
 
@@ -535,6 +537,9 @@ pub struct Summary {
     pub levels: Counts<Lod, u64>,
     /// Level switches: `total`, and by direction (`"hybrid->rigid"`, ...).
     pub switches: SwitchCounts,
+    /// Of those, the switches off screen that no collision forced: not drawn, so not in
+    /// `pops`.
+    pub switches_unseen: u64,
     /// Creatures at each level, averaged over the run's steering decisions, and the peak.
     pub levels_mean: Counts<Lod, f64>,
     /// The most creatures at each level at any decision.
@@ -542,8 +547,8 @@ pub struct Summary {
     /// The cost model's prediction of a frame from the levels simulated in it, whatever the
     /// policy: on average and the slowest.
     pub predicted_frame: PredictedFrame,
-    /// The pops of the switches in what is drawn, by kind of switch (from, to, forced by a
-    /// collision or not): the largest and the 95th percentile.
+    /// The pops of the switches in what is drawn (all but `switches_unseen`), by kind of
+    /// switch (from, to, forced by a collision or not): the largest and the 95th percentile.
     pub pops: Vec<PopSummary>,
     /// Under the budget policy: the budget, the predicted frame and the decisions over it.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -579,6 +584,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
     let samples = switching.samples.max(1) as f64;
     Summary {
         switches: switching.switches,
+        switches_unseen: switching.unseen,
         levels_mean: Counts::from_fn(|l| switching.level_sums[l] as f64 / samples),
         levels_peak: switching.level_peaks,
         predicted_frame: PredictedFrame {

@@ -134,6 +134,12 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
         .chain([format!("total {}", s.switches.total())])
         .collect();
     println!("level switches: {}", switches.join(", "));
+    if s.switches_unseen > 0 {
+        println!(
+            "  {} of them off screen: not drawn, so not blended nor measured for pops",
+            s.switches_unseen
+        );
+    }
     if let Some(b) = &s.budget {
         let chosen = if b.decisions_over_budget == 0 {
             "within it at every decision".to_owned()
