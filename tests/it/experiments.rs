@@ -570,6 +570,46 @@ fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
 }
 
 #[test]
+fn the_budget_at_every_crowd_size_can_price_its_games_by_a_model_measured_just_before_them() {
+    let dir = scratch_dir("budget_scale_calibrated");
+    let file = dir.join("budget_scale.ron");
+    let predicted = |calibrate: bool| {
+        let settings = format!(
+            "(creatures: [30], budgets_ms: [3.0], adaptive_frames: [0.0], seconds: 0.3, warm_up_s: 0.1, seed: 3, calibrate_at_start: {calibrate})"
+        );
+        std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
+        let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("budget-scale.json")).unwrap()).unwrap();
+        let summary = &json["summary"];
+        let game = &summary["games"][0];
+        (
+            said,
+            summary["calibrated_at_start"].clone(),
+            game["predicted_mean_ms"].as_f64().unwrap(),
+        )
+    };
+    let (said, model, measured) = predicted(true);
+    assert!(
+        said.contains("a cost model measured on this machine just before the games"),
+        "{said}"
+    );
+    // The model measured is in the record, a line for each kind and one for the frame.
+    let lines = model.as_array().unwrap_or_else(|| panic!("{model}"));
+    assert!(
+        lines.iter().any(|l| l.as_str().unwrap().starts_with("hopper")),
+        "{model}"
+    );
+    let first = format!("\n- {}\n", lines[0].as_str().unwrap());
+    assert!(said.contains(&first), "the report lists it: {said}");
+    let (said, model, shipped) = predicted(false);
+    assert!(said.contains("rules and cost model (the game's)"), "{said}");
+    assert!(model.is_null(), "{model}");
+    // The same game priced by the two models: its prediction is the measured model's.
+    assert_ne!(measured, shipped);
+}
+
+#[test]
 fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys_more_with_more() {
     let dir = scratch_dir("budget_scale");
     let file = dir.join("budget_scale.ron");

@@ -1,5 +1,6 @@
 //! The budget at every crowd size: the budget policy under the scenario's own rules and cost
-//! model (the game's), for each crowd size and each frame budget, with the cost model alone
+//! model (the game's, or one measured on this machine just before the games, as the game does at
+//! start-up), for each crowd size and each frame budget, with the cost model alone
 //! and corrected by the measured frames (the adaptive mode, keeping their mean or a percentile
 //! of them at the budget). Each game's frames are timed: the mean and the 99th percentile
 //! against the budget, and what the policy predicted, after the game's first moments (its
@@ -12,7 +13,7 @@ use std::path::Path;
 
 use super::plot::{self, Mark, Panel, Series};
 use super::{ExperimentRecord, Options, command, load_settings, p99_ms, percentile_ms, timed_frames};
-use crate::bench::scaled;
+use crate::bench::{Calibration, calibrate, cost_model_lines, scaled};
 use simlod::config::{SimConfig, Validate, Validator};
 use simlod::contract::threads_for;
 use simlod::headless::HeadlessSim;
@@ -43,6 +44,11 @@ pub struct BudgetScaleSettings {
     pub warm_up_s: f32,
     /// The games' seed.
     pub seed: u64,
+    /// Whether the games are priced by a cost model measured on this machine just before them,
+    /// as the game does at start-up (`frame_budget.calibrate_at_start` in `game.ron`), not the
+    /// one the rules name (a file without it: the rules').
+    #[serde(default)]
+    pub calibrate_at_start: bool,
 }
 
 impl BudgetScaleSettings {
@@ -274,6 +280,16 @@ const HEADER: &str = "creatures,budget_ms,adaptive_frames,adaptive_percentile,fr
 /// report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: BudgetScaleSettings = load_settings(file, options)?;
+    let measured;
+    let config = if s.calibrate_at_start {
+        measured = SimConfig {
+            costs: calibrate(config, Calibration::AtStartUp),
+            ..config.clone()
+        };
+        &measured
+    } else {
+        config
+    };
     let adaptive = s.adaptive_settings();
     let total = s.creatures.len() * s.budgets_ms.len() * adaptive.len();
     let mut progress = super::Progress::new("budget at every crowd size", total as u64);
@@ -290,6 +306,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     let frames = games.first().map_or(1, |g| g.frames);
     let machine: Vec<MachineSpread> = s.budgets_ms.iter().map(|&b| machine_spread(b, frames)).collect();
     drop(progress);
+    let measured_model = s.calibrate_at_start.then(|| cost_model_lines(&config.costs));
     let mut csv = format!("{HEADER}\n");
     for g in &games {
         let _ = writeln!(
@@ -315,8 +332,12 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     ExperimentRecord {
         experiment: "budget-scale".into(),
         command: command("budget-scale", options),
-        summary: serde_json::json!({ "games": games, "machine": machine }),
-        report: report(&games, &machine, &s),
+        summary: serde_json::json!({
+            "games": games,
+            "machine": machine,
+            "calibrated_at_start": measured_model,
+        }),
+        report: report(&games, &machine, &s, measured_model.as_deref()),
         smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
@@ -386,7 +407,14 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
     Ok(())
 }
 
-fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) -> String {
+/// The report: the games, how many kept the budget, the machine's own spread, and the cost model
+/// measured before the games (`measured_model`, its lines), if one was.
+fn report(
+    games: &[Game],
+    machine: &[MachineSpread],
+    s: &BudgetScaleSettings,
+    measured_model: Option<&[String]>,
+) -> String {
     // The frames a game holds after its warm-up, and which of them, slowest first, is its 99th
     // percentile: the slowest of all in a game under 100 frames.
     let frames = games.first().map_or(0, |g| g.frames);
@@ -394,8 +422,14 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) ->
         0 => "its slowest frame".to_owned(),
         slower => format!("the slowest after the {slower} slowest"),
     };
+    let rules = if s.calibrate_at_start {
+        "rules (the game's) and a cost model measured on this machine just before the games, as the game does at start-up \
+         (the crowd's shares kept from the rules' model)"
+    } else {
+        "rules and cost model (the game's)"
+    };
     let mut report = format!(
-        "The budget policy under the scenario's own rules and cost model (the game's), seed {}, games of {} s: the scenario's mix, \
+        "The budget policy under the scenario's own {rules}, seed {}, games of {} s: the scenario's mix, \
          the court grown with the count to the default game's density. Every frame's simulation timed on this machine's cores. \
          The first {} s of each game, its warm-up (the world's bodies built, every creature searched for contacts once), is left \
          out of the mean, the 99th percentile and the prediction; its slowest frame is in the last column. \
@@ -453,6 +487,12 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings) ->
             m.p99_ms,
             m.p99_over_median()
         );
+    }
+    if let Some(lines) = measured_model {
+        report += "\nThe cost model measured before the games (us per creature per 1/30 s):\n\n";
+        for line in lines {
+            let _ = writeln!(report, "- {line}");
+        }
     }
     report
 }
