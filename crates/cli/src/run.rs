@@ -136,7 +136,7 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
     println!("level switches: {}", switches.join(", "));
     if s.switches_unseen > 0 {
         println!(
-            "  {} of them off screen: not drawn, so not blended nor measured for pops",
+            "  {} of them off screen: not drawn, so neither blended nor measured for their pops",
             s.switches_unseen
         );
     }
