@@ -570,41 +570,55 @@ fn the_crowd_stops_a_policy_at_the_first_size_whose_frame_passes_the_limit() {
 }
 
 #[test]
-fn the_budget_at_every_crowd_size_can_price_its_games_by_a_model_measured_just_before_them() {
+fn the_budget_at_every_crowd_size_can_price_each_sizes_games_by_a_model_measured_just_before_them() {
     let dir = scratch_dir("budget_scale_calibrated");
     let file = dir.join("budget_scale.ron");
     let predicted = |calibrate: bool| {
         let settings = format!(
-            "(creatures: [30], budgets_ms: [3.0], adaptive_frames: [0.0], seconds: 0.3, warm_up_s: 0.1, seed: 3, calibrate_at_start: {calibrate})"
+            "(creatures: [12, 30], budgets_ms: [3.0], adaptive_frames: [0.0], seconds: 0.3, warm_up_s: 0.1, seed: 3, calibrate_at_start: {calibrate})"
         );
         std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
         let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
         let json: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(dir.join("budget-scale.json")).unwrap()).unwrap();
         let summary = &json["summary"];
-        let game = &summary["games"][0];
+        let game = &summary["games"][1];
         (
             said,
             summary["calibrated_at_start"].clone(),
             game["predicted_mean_ms"].as_f64().unwrap(),
         )
     };
-    let (said, model, measured) = predicted(true);
+    let (said, models, measured) = predicted(true);
     assert!(
-        said.contains("a cost model measured on this machine just before the games"),
+        said.contains("a cost model measured on this machine just before each crowd size's games"),
         "{said}"
     );
-    // The model measured is in the record, a line for each kind and one for the frame.
-    let lines = model.as_array().unwrap_or_else(|| panic!("{model}"));
-    assert!(
-        lines.iter().any(|l| l.as_str().unwrap().starts_with("hopper")),
-        "{model}"
-    );
-    let first = format!("\n- {}\n", lines[0].as_str().unwrap());
-    assert!(said.contains(&first), "the report lists it: {said}");
-    let (said, model, shipped) = predicted(false);
+    // A model for each crowd size is in the record, a line for each kind and one for the
+    // frame, and the report lists it.
+    let models = models.as_array().unwrap_or_else(|| panic!("{models}"));
+    let sizes: Vec<u64> = models.iter().map(|m| m["creatures"].as_u64().unwrap()).collect();
+    assert_eq!(sizes, [12, 30]);
+    for model in models {
+        let lines = model["lines"].as_array().unwrap_or_else(|| panic!("{model}"));
+        assert!(
+            lines.iter().any(|l| l.as_str().unwrap().starts_with("hopper")),
+            "{model}"
+        );
+        let first = format!("\n- {}\n", lines[0].as_str().unwrap());
+        assert!(said.contains(&first), "the report lists it: {said}");
+        // Its rigid level measured among that crowd's own creatures: never more rigid ones
+        // than it has.
+        let rigid = lines.last().unwrap().as_str().unwrap();
+        let most: u64 = (rigid.split(": ").nth(1).unwrap().split(", "))
+            .map(|r| r.split(" x ").next().unwrap().parse::<u64>().unwrap())
+            .max()
+            .unwrap();
+        assert!(most <= model["creatures"].as_u64().unwrap(), "{rigid}");
+    }
+    let (said, models, shipped) = predicted(false);
     assert!(said.contains("rules and cost model (the game's)"), "{said}");
-    assert!(model.is_null(), "{model}");
+    assert!(models.is_null(), "{models}");
     // The same game priced by the two models: its prediction is the measured model's.
     assert_ne!(measured, shipped);
 }

@@ -511,9 +511,13 @@ fn the_costs_measured_at_start_up_stand_through_edits_of_the_rules_and_of_the_sc
 }
 
 #[test]
-fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_and_rigid_shares() {
-    let config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
-    let measured = simlod_lab::bench::calibrate(&config, simlod_lab::bench::Calibration::AtStartUp);
+fn calibrating_at_start_up_measures_every_level_and_the_shares_in_the_crowd_that_plays() {
+    use simlod_lab::bench::{Calibration, calibrate};
+    let mut config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
+    // Room for every creature at the rigid level, on any machine.
+    config.rules.budget.frame_budget_ms = 100.0;
+    let creatures = config.scenario.creature_count();
+    let measured = calibrate(&config, Calibration::AtStartUp { creatures });
     // Every kind of the scenario, a rigid creature far dearer than a hybrid one; the court
     // and the puck cost something whatever the creatures, and so does the choice; where only
     // the floors fit, the choice is a pass over the creatures and costs less.
@@ -531,11 +535,33 @@ fn calibrating_at_start_up_measures_every_level_and_keeps_the_files_crowd_and_ri
             && measured.floors_only_us_per_creature < measured.decision_us_per_creature,
         "{measured:?}"
     );
-    // A crowd of tens of thousands is not measured at start-up: its shares are the file's.
+    // The default game is no crowd: the crowd's shares are the file's, for a crowd a new
+    // round may bring.
     assert!(config.costs.crowd_shares.is_some() && !config.costs.larger_crowd_shares.is_empty());
     assert_eq!(measured.crowd_shares, config.costs.crowd_shares);
     assert_eq!(measured.larger_crowd_shares, config.costs.larger_crowd_shares);
-    // Nor are hundreds of rigid creatures in play: the rigid level's shares are the file's.
-    assert!(!config.costs.rigid_shares.is_empty());
-    assert_eq!(measured.rigid_shares, config.costs.rigid_shares);
+    // The rigid level's shares are measured among the game's own creatures: ten rigid first,
+    // then more, up to the first count the budget holds (here all 40), never more than the
+    // game has.
+    let rigid: Vec<u32> = measured.rigid_shares.iter().map(|r| r.rigid).collect();
+    assert!(rigid.len() >= 2, "{rigid:?}");
+    assert!((5..=15).contains(&rigid[0]), "{rigid:?}");
+    assert!(rigid.windows(2).all(|w| w[0] < w[1]), "{rigid:?}");
+    assert!(*rigid.last().unwrap() <= creatures, "{rigid:?}");
+    assert!(measured.rigid_shares.iter().all(|r| r.share > 0.0), "{measured:?}");
+}
+
+#[test]
+fn calibrating_at_start_up_for_a_crowd_measures_its_shares_at_that_crowd() {
+    use simlod_lab::bench::{Calibration, calibrate};
+    let mut config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
+    // Room for no rigid creature: only the first count of them is measured.
+    config.rules.budget.frame_budget_ms = 0.5;
+    let creatures = simlod::PARALLEL_MIN_CREATURES + 500;
+    let measured = calibrate(&config, Calibration::AtStartUp { creatures });
+    let shares = measured.crowd_shares.unwrap_or_else(|| panic!("{measured:?}"));
+    assert_eq!(shares.creatures, creatures);
+    assert!(measured.larger_crowd_shares.is_empty(), "{measured:?}");
+    assert_ne!(Some(shares), config.costs.crowd_shares);
+    assert_eq!(measured.rigid_shares.len(), 1, "{measured:?}");
 }

@@ -111,7 +111,12 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
 fn measure_costs(config: &SimConfig) -> CostModel {
     info!("measuring the budget policy's costs on this machine (frame_budget.calibrate_at_start in {GAME_FILE})");
     let start = std::time::Instant::now();
-    let model = simlod_lab::bench::calibrate(config, simlod_lab::bench::Calibration::AtStartUp);
+    let model = simlod_lab::bench::calibrate(
+        config,
+        simlod_lab::bench::Calibration::AtStartUp {
+            creatures: config.scenario.creature_count(),
+        },
+    );
     let mut said = format!(
         "measured in {:.1} s (us per creature per 1/30 s):",
         start.elapsed().as_secs_f32()

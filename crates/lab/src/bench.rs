@@ -352,9 +352,12 @@ pub enum Calibration {
     /// (about 10 s here).
     Full,
     /// The game's start-up (`frame_budget.calibrate_at_start` in `game.ron`): three shorter
-    /// passes, and the crowd's shares kept from the model the files give, since the game does
-    /// not play a crowd of tens of thousands (about 1.3 s here).
-    AtStartUp,
+    /// passes, then the shares in the crowd that plays, `creatures` of the scenario's mix (see
+    /// `in_the_crowd_that_plays`): about 2 s here for the default game.
+    AtStartUp {
+        /// The creatures the game plays, the scenario's mix scaled as [`scaled`] does.
+        creatures: u32,
+    },
     /// One short pass (`--quick`): a rough figure in half a second.
     Quick,
 }
@@ -369,32 +372,142 @@ pub enum Calibration {
 /// (see `choice_cost_us`, `choice_in_play_us`); last, the rigid level in play as shares of its
 /// figures by the count of rigid creatures (see `rigid_in_play`), and the cheap levels' cost
 /// per creature in a crowd stepped across the cores, as shares of their cost on one thread
-/// (both, at start-up, kept from `config.costs`).
+/// (both, at start-up, in the crowd that plays: see `in_the_crowd_that_plays`).
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     // Whole passes over every figure, each figure the median of the passes': a pass takes a
     // few seconds, and this machine has slow spells as long (rigid creatures and the fixed
     // cost measured a third dearer throughout one calibration, and not in the next).
     let passes = match how {
-        Calibration::Full | Calibration::AtStartUp => 3,
+        Calibration::Full | Calibration::AtStartUp { .. } => 3,
         Calibration::Quick => 1,
     };
-    median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>())
+    let model = median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>());
+    match how {
+        Calibration::AtStartUp { creatures } => in_the_crowd_that_plays(config, model, creatures),
+        Calibration::Full | Calibration::Quick => model,
+    }
+}
+
+/// The creatures of the scenario's mix a level's cost on one thread is measured among, below a
+/// crowd (see [`simlod::PARALLEL_MIN_CREATURES`]).
+const BELOW_A_CROWD: u32 = 2000;
+
+/// The counts of rigid creatures the rigid level's shares in play are measured at.
+const RIGID_COUNTS: [u32; 5] = [10, 40, 160, 400, 800];
+
+/// Microseconds a frame of `count` creatures of `config` all under `policy` takes over a court
+/// without creatures stepped beside it, per creature.
+fn per_creature_us(config: &SimConfig, count: u32, policy: LevelPolicy, (warmup, frames): (usize, usize)) -> f64 {
+    let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
+    (median_extra_seconds(&world, &court, warmup, frames) * 1e6).max(0.0) / f64::from(count)
+}
+
+/// The game's start-up: `model`'s shares in the crowd that plays, `creatures` of the scenario's
+/// mix. Where it is a crowd, the cheap levels' and the choice's (see [`crowd_shares`]); else the
+/// file's, for a crowd a new round may bring. Then the rigid level's in play in that crowd (see
+/// [`rigid_in_play`]) at each count of [`RIGID_COUNTS`] up to the first the rules' budget
+/// holds. Kept from a file measured on another machine, these shares priced 100,000 point
+/// masses at three quarters of what they ran, and 350 rigid creatures among 4,000 at 0.57
+/// (2026-11-29).
+fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> CostModel {
+    let effort = (30, 20);
+    (model.crowd_shares, model.larger_crowd_shares) = if creatures >= simlod::PARALLEL_MIN_CREATURES {
+        (Some(crowd_shares(config, &model, creatures, effort)), Vec::new())
+    } else {
+        (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone())
+    };
+    model.rigid_shares = Vec::new();
+    let [point_mass, hybrid, rigid_us] = mix_us(config, &model, creatures, 0);
+    let holds = (f64::from(config.rules.budget.frame_budget_ms) * 1e3
+        - f64::from(model.overhead_us(creatures as usize))
+        - f64::from(creatures) * point_mass.max(hybrid))
+        / rigid_us.max(1e-9);
+    let mut counts: Vec<u32> = RIGID_COUNTS
+        .iter()
+        .map(|&r| r.min(creatures))
+        .filter(|&r| r > 0)
+        .collect();
+    counts.dedup();
+    let needed = counts
+        .iter()
+        .position(|&r| f64::from(r) >= holds)
+        .map_or(counts.len(), |i| i + 1);
+    counts.truncate(needed.max(1));
+    model.rigid_shares = rigid_shares(config, &model, &counts, |_| creatures, effort);
+    model
+}
+
+/// The rigid level's shares in play (see [`rigid_in_play`]) with room for each of `counts`
+/// rigid creatures among `among(count)` creatures, by how many were rigid. The file requires
+/// the counts rising: one that came out no more than the one before is left out.
+fn rigid_shares(
+    config: &SimConfig,
+    model: &CostModel,
+    counts: &[u32],
+    among: impl Fn(u32) -> u32,
+    effort: (usize, usize),
+) -> Vec<RigidShare> {
+    let mut shares: Vec<RigidShare> = Vec::new();
+    for &count in counts {
+        let (rigid, share) = rigid_in_play(config, model, among(count), count, effort);
+        if shares.last().is_none_or(|fewer| rigid > fewer.rigid) {
+            shares.push(RigidShare { rigid, share });
+        }
+    }
+    shares
+}
+
+/// The cheap levels' and the choice's shares in the scenario's crowd of `count`, stepped across
+/// the cores, of `model`'s figures (measured among [`BELOW_A_CROWD`], on one thread). Each level's crowd figure is taken right after the one-thread
+/// figure it is a share of: taken apart, a slow spell of the machine under one of them moved
+/// the share by a third. The choice's is of the choice in play at that size (see
+/// [`choice_in_play_us`]): what it does beside the choice itself (writing the levels, the
+/// switch stage's passes) is a smaller part of it there. Taken by the choice alone's share,
+/// the model charged 40,000 creatures at 30 ms about 13 ms too much a frame (2026-11-28). The
+/// rigid level's share is left at 1.
+fn crowd_shares(config: &SimConfig, model: &CostModel, count: u32, (warmup, frames): (usize, usize)) -> CrowdShares {
+    let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
+    let level_share = |policy| {
+        let alone = per_creature_us(config, BELOW_A_CROWD, policy, (warmup, frames));
+        share(per_creature_us(config, count, policy, (warmup, frames)), alone)
+    };
+    let (point_mass, hybrid) = (
+        level_share(LevelPolicy::AllPointMass),
+        level_share(LevelPolicy::AllHybrid),
+    );
+    let crowd = choice_cost_us(config, model, count, (warmup, frames.div_ceil(3)), false);
+    let mut shares = CrowdShares {
+        creatures: count,
+        point_mass,
+        hybrid,
+        choice: 1.0,
+        floors_only: share(crowd.floors_only_us, f64::from(model.floors_only_us_per_creature)),
+        rigid: 1.0,
+    };
+    let at_count = CostModel {
+        crowd_shares: Some(shares),
+        larger_crowd_shares: Vec::new(),
+        ..model.clone()
+    };
+    let in_play = choice_in_play_us(
+        config,
+        &at_count,
+        count,
+        crowd.per_creature_us,
+        (warmup.max(30), frames),
+    );
+    shares.choice = share(in_play, f64::from(model.decision_us_per_creature));
+    shares
 }
 
 /// One pass of [`calibrate`]: every figure measured once.
 fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     let (warmup, frames, cheap_count, rigid_count) = match how {
-        Calibration::Full => (30, 45, 2000, 30),
-        Calibration::AtStartUp => (20, 20, 2000, 20),
+        Calibration::Full => (30, 45, BELOW_A_CROWD, 30),
+        Calibration::AtStartUp { .. } => (20, 20, BELOW_A_CROWD, 20),
         Calibration::Quick => (10, 15, 400, 10),
     };
     let kinds = KindTable::of(config);
-    // Microseconds a frame of `count` creatures of `config` all under `policy` takes over a
-    // court without creatures, per creature.
-    let per_creature_us = |config: &SimConfig, count: u32, policy: LevelPolicy| {
-        let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
-        (median_extra_seconds(&world, &court, warmup, frames) * 1e6).max(0.0) / f64::from(count)
-    };
     // Cheap to measure: many frames, several runs.
     let fixed_us = median_of_runs(&scaled(config, 0, LevelPolicy::AllPointMass), 3, warmup, 5 * frames) * 1e6;
     let mut entries = Vec::new();
@@ -408,7 +521,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
                 Lod::Hybrid => (LevelPolicy::AllHybrid, cheap_count),
                 Lod::Rigid => (LevelPolicy::AllRigid, rigid_count),
             };
-            us[level as usize] = per_creature_us(&alone, count, policy);
+            us[level as usize] = per_creature_us(&alone, count, policy, (warmup, frames));
         }
         // A kind without a level is predicted at the next cheaper level it has.
         for l in 1..3 {
@@ -452,80 +565,36 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         choice.per_creature_us,
         (warmup.max(30), frames),
     ) as f32;
-    if how == Calibration::AtStartUp {
-        model.crowd_shares = config.costs.crowd_shares;
-        model.larger_crowd_shares = config.costs.larger_crowd_shares.clone();
-        model.rigid_shares = config.costs.rigid_shares.clone();
+    if let Calibration::AtStartUp { .. } = how {
         return model;
     }
-    // The rigid level in play, among ten rigid creatures and among hundreds (see
-    // `rigid_in_play`); the warm-up long enough for the budget's creatures to reach their
-    // levels. A count is at least one more than the one before, as the file requires.
+    // The rigid level in play, among ten rigid creatures and among hundreds, in crowds of four
+    // times as many; the warm-up long enough for the budget's creatures to reach their levels.
     let rigid_counts: &[u32] = match how {
         Calibration::Quick => &[10, 100],
-        _ => &[10, 40, 160, 400, 800],
+        _ => &RIGID_COUNTS,
     };
-    let mut fewer = 0;
-    model.rigid_shares = (rigid_counts.iter())
-        .map(|&rigid| {
-            let (rigid, share) = rigid_in_play(config, &model, 4 * rigid, rigid, (warmup.max(30), frames));
-            let rigid = rigid.max(fewer + 1);
-            fewer = rigid;
-            RigidShare { rigid, share }
-        })
-        .collect();
-    // The cheap levels in crowds stepped across the cores: the scenario's mix at each crowd
-    // size against the same below a crowd, per creature (a creature costs less the larger the
-    // crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two thirds of it).
+    model.rigid_shares = rigid_shares(
+        config,
+        &model,
+        rigid_counts,
+        |rigid| 4 * rigid,
+        (warmup.max(30), frames),
+    );
+    // The cheap levels and the choice in crowds stepped across the cores (a creature costs less
+    // the larger the crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two
+    // thirds of it, 2026-11-27).
     let crowds: &[u32] = match how {
         Calibration::Quick => &[8 * simlod::PARALLEL_MIN_CREATURES],
         _ => &[2, 8, 32].map(|k| k * simlod::PARALLEL_MIN_CREATURES),
     };
-    // Each crowd's figure right after the one-thread figure it is a share of: taken apart, a
-    // slow spell of the machine under one of them moved the share by a third.
-    let shares = |policy: LevelPolicy| -> Vec<f32> {
-        let alone = per_creature_us(config, cheap_count, policy).max(1e-6);
-        (crowds.iter())
-            .map(|&count| (per_creature_us(config, count, policy) / alone).clamp(0.01, 10.0) as f32)
-            .collect()
-    };
-    let (point_mass, hybrid) = (shares(LevelPolicy::AllPointMass), shares(LevelPolicy::AllHybrid));
-    // The choice's too: in a crowd its per-creature work runs across the cores, and most of
-    // its listing and sorting is by creature, not by search. Its pass where only the floors
-    // fit runs on one thread.
-    let choice_at = |count| choice_cost_us(config, &model, count, (warmup, frames.div_ceil(3)), false);
-    let alone = choice_at(cheap_count);
-    let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
-    let choice: Vec<ChoiceCost> = crowds.iter().map(|&count| choice_at(count)).collect();
-    let mut measured: Vec<CrowdShares> = (crowds.iter().zip(point_mass.iter().zip(&hybrid)).zip(&choice))
-        .map(|((&creatures, (&point_mass, &hybrid)), crowd)| CrowdShares {
-            creatures,
-            point_mass,
-            hybrid,
-            choice: share(crowd.per_creature_us, alone.per_creature_us),
-            floors_only: share(crowd.floors_only_us, alone.floors_only_us),
-            rigid: 1.0,
-        })
+    let mut measured: Vec<CrowdShares> = (crowds.iter())
+        .map(|&count| crowd_shares(config, &model, count, (warmup, frames)))
         .collect();
     let with_shares = |model: &mut CostModel, measured: &[CrowdShares]| {
         model.crowd_shares = measured.first().copied();
         model.larger_crowd_shares = measured[1..].to_vec();
     };
-    // Then the choice in play at each crowd's size, as at 2,000: what it does beside the choice
-    // itself (writing the levels, the switch stage's passes) is a smaller part of it there.
-    // Taken there by the choice alone's shares, the model charged 40,000 creatures at 30 ms
-    // about 13 ms too much a frame (2026-11-28).
-    with_shares(&mut model, &measured);
-    for (shares, crowd) in measured.iter_mut().zip(&choice) {
-        let in_play = choice_in_play_us(
-            config,
-            &model,
-            shares.creatures,
-            crowd.per_creature_us,
-            (warmup.max(30), frames),
-        );
-        shares.choice = share(in_play, f64::from(model.decision_us_per_creature));
-    }
     // Then the rigid level among each crowd, at its share among as many rigid creatures: among
     // tens of thousands it cost more than among four times the rigid ones (100,000 creatures at
     // 30 ms ran 1.21 times the budget without it, 2026-11-27). The cheap levels and the choice
@@ -747,21 +816,17 @@ fn mix_us(config: &SimConfig, model: &CostModel, count: u32, rigid: u32) -> [f64
 /// The choice's cost per creature in play: the scenario's crowd of `count` under the budget
 /// with room for about half of it at the hybrid level and none rigid (the rigid level priced
 /// out of reach, the choice charged at `alone_us`, the choice alone timed among `count`), what
-/// its frames take beyond its levels and its searches. Besides the choice itself
-/// (`choice_now`), this is the writing of every creature's level, the switch stage's passes,
-/// the switches between the cheap levels and a world of a table for each level: timed as the
-/// choice alone, the cheap levels in a world of mixed levels ran about twice their prediction
-/// at 4,000 creatures, and 100,000 under the camera rule 1.3 times all hybrid's stages. Its
-/// levels are priced by the same crowd all point masses and all hybrid, the three stepped a
-/// frame each in turn (see [`median_extra_seconds`]): priced by shares measured apart, the
-/// choice's part came out at nothing in one calibration and a third of the next's.
-fn choice_in_play_us(
-    config: &SimConfig,
-    model: &CostModel,
-    count: u32,
-    alone_us: f64,
-    (warmup, frames): (usize, usize),
-) -> f64 {
+/// its frames take (their median) beyond what `model` says of the rest of them: the fixed
+/// cost, the searches and the cheap levels at their shares in the crowd. Besides the choice
+/// itself (`choice_now`), this is the writing of every creature's level, the switch stage's
+/// passes, the switches between the cheap levels and a world of a table for each level: timed
+/// as the choice alone, the cheap levels in a world of mixed levels ran about twice their
+/// prediction at 4,000 creatures. Taken beyond the same crowd all point masses and all hybrid
+/// stepped beside it, in place of the model's figures, it came out at a tenth of the choice
+/// alone in crowds of tens of thousands, and the model priced 40,000 creatures' cheap frame at
+/// 6.8 ms where it ran 12 (2026-11-29): three worlds of a crowd stepped in turn crowd each
+/// other out of the caches, so the two beside were dearer than the model's figures for them.
+fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us: f64, effort: (usize, usize)) -> f64 {
     let mut priced = model.clone();
     for k in &mut priced.kinds {
         k.costs.rigid_us_per_frame = 1e6;
@@ -773,34 +838,8 @@ fn choice_in_play_us(
     }
     let [pm, hybrid, _] = mix_us(config, &priced, count, 0);
     let room_us = f64::from(priced.overhead_us(count as usize)) + f64::from(count) * (pm + hybrid) / 2.0;
-    let mut choosing = scaled(config, count, LevelPolicy::Budget);
-    choosing.costs = priced;
-    let budget = &mut choosing.rules.budget;
-    (budget.frame_budget_ms, budget.adaptive_frames) = ((room_us / 1e3) as f32, 0.0);
-    let mut sims = [
-        choosing,
-        scaled(config, count, LevelPolicy::AllPointMass),
-        scaled(config, count, LevelPolicy::AllHybrid),
-    ]
-    .map(HeadlessSim::new);
-    for _ in 0..warmup {
-        sims.iter_mut().for_each(HeadlessSim::advance_frame);
-    }
-    let searched = |sim: &HeadlessSim| sim.app.world().resource::<BudgetTally>().searched;
-    let extra_s = (0..frames)
-        .map(|_| {
-            let before = searched(&sims[0]);
-            let [choosing_s, points_s, hybrids_s] = sims.each_mut().map(timed_frame);
-            let searches = (searched(&sims[0]) - before) as f64;
-            let world = sims[0].app.world_mut();
-            let hybrids = (world.query::<&Lod>().iter(world))
-                .filter(|&&l| l == Lod::Hybrid)
-                .count();
-            let h = hybrids as f64 / f64::from(count.max(1));
-            choosing_s - (1.0 - h) * points_s - h * hybrids_s - searches * f64::from(model.contact_search_us) * 1e-6
-        })
-        .collect();
-    (median(extra_s) * 1e6 / f64::from(count.max(1))).max(0.0)
+    let game = in_play(config, &priced, count, room_us, effort);
+    ((game.median_us - game.cheap_us) / f64::from(count.max(1))).max(0.0)
 }
 
 /// The rigid level's cost in play as a share of what `model` says of it (among four times as

@@ -1,6 +1,6 @@
 //! The budget at every crowd size: the budget policy under the scenario's own rules and cost
-//! model (the game's, or one measured on this machine just before the games, as the game does at
-//! start-up), for each crowd size and each frame budget, with the cost model alone
+//! model (the game's, or one measured on this machine just before each crowd size's games, as the
+//! game does at start-up), for each crowd size and each frame budget, with the cost model alone
 //! and corrected by the measured frames (the adaptive mode, keeping their mean or a percentile
 //! of them at the budget). Each game's frames are timed: the mean and the 99th percentile
 //! against the budget, and what the policy predicted, after the game's first moments (its
@@ -44,9 +44,9 @@ pub struct BudgetScaleSettings {
     pub warm_up_s: f32,
     /// The games' seed.
     pub seed: u64,
-    /// Whether the games are priced by a cost model measured on this machine just before them,
-    /// as the game does at start-up (`frame_budget.calibrate_at_start` in `game.ron`), not the
-    /// one the rules name (a file without it: the rules').
+    /// Whether each crowd size's games are priced by a cost model measured on this machine just
+    /// before them, in that crowd, as the game does at start-up (`frame_budget.calibrate_at_start`
+    /// in `game.ron`), not the one the rules name (a file without it: the rules').
     #[serde(default)]
     pub calibrate_at_start: bool,
 }
@@ -216,6 +216,14 @@ fn game(
     }
 }
 
+/// A cost model measured before a crowd size's games (`calibrate_at_start`).
+#[derive(Clone, Debug, Serialize)]
+struct MeasuredModel {
+    creatures: u32,
+    /// What it says, a line each (see [`cost_model_lines`]).
+    lines: Vec<String>,
+}
+
 /// The machine's own spread at one budget: a fixed job on each of the compute pool's threads (as
 /// a crowd's stages run), its length set to about the budget, timed as many times as a game has
 /// frames. Where its 99th percentile is over 1.25 times its median, no game that spends the
@@ -280,21 +288,31 @@ const HEADER: &str = "creatures,budget_ms,adaptive_frames,adaptive_percentile,fr
 /// report and returns what it says.
 pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String, LabError> {
     let s: BudgetScaleSettings = load_settings(file, options)?;
-    let measured;
-    let config = if s.calibrate_at_start {
-        measured = SimConfig {
-            costs: calibrate(config, Calibration::AtStartUp),
-            ..config.clone()
-        };
-        &measured
-    } else {
-        config
-    };
     let adaptive = s.adaptive_settings();
     let total = s.creatures.len() * s.budgets_ms.len() * adaptive.len();
     let mut progress = super::Progress::new("budget at every crowd size", total as u64);
     let mut games = Vec::with_capacity(total);
+    // With `calibrate_at_start`, each crowd size's model, as its lines.
+    let mut measured_models = Vec::new();
     for &n in &s.creatures {
+        let measured;
+        let config = if s.calibrate_at_start {
+            // Measured as the game would for this crowd, its rigid shares up to what the
+            // largest budget holds.
+            let mut largest = config.clone();
+            largest.rules.budget.frame_budget_ms = s.budgets_ms.iter().copied().fold(0.0, f32::max);
+            measured = SimConfig {
+                costs: calibrate(&largest, Calibration::AtStartUp { creatures: n }),
+                ..config.clone()
+            };
+            measured_models.push(MeasuredModel {
+                creatures: n,
+                lines: cost_model_lines(&measured.costs),
+            });
+            &measured
+        } else {
+            config
+        };
         for &b in &s.budgets_ms {
             for &a in &adaptive {
                 games.push(game(config, &s, n, b, a));
@@ -306,7 +324,6 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     let frames = games.first().map_or(1, |g| g.frames);
     let machine: Vec<MachineSpread> = s.budgets_ms.iter().map(|&b| machine_spread(b, frames)).collect();
     drop(progress);
-    let measured_model = s.calibrate_at_start.then(|| cost_model_lines(&config.costs));
     let mut csv = format!("{HEADER}\n");
     for g in &games {
         let _ = writeln!(
@@ -335,9 +352,9 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
         summary: serde_json::json!({
             "games": games,
             "machine": machine,
-            "calibrated_at_start": measured_model,
+            "calibrated_at_start": s.calibrate_at_start.then_some(&measured_models),
         }),
-        report: report(&games, &machine, &s, measured_model.as_deref()),
+        report: report(&games, &machine, &s, &measured_models),
         smoke_test: options.quick,
     }
     .finish(&options.out, &csv)
@@ -407,14 +424,9 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
     Ok(())
 }
 
-/// The report: the games, how many kept the budget, the machine's own spread, and the cost model
-/// measured before the games (`measured_model`, its lines), if one was.
-fn report(
-    games: &[Game],
-    machine: &[MachineSpread],
-    s: &BudgetScaleSettings,
-    measured_model: Option<&[String]>,
-) -> String {
+/// The report: the games, how many kept the budget, the machine's own spread, and the cost
+/// models measured before each crowd size's games, if they were.
+fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, measured: &[MeasuredModel]) -> String {
     // The frames a game holds after its warm-up, and which of them, slowest first, is its 99th
     // percentile: the slowest of all in a game under 100 frames.
     let frames = games.first().map_or(0, |g| g.frames);
@@ -423,8 +435,8 @@ fn report(
         slower => format!("the slowest after the {slower} slowest"),
     };
     let rules = if s.calibrate_at_start {
-        "rules (the game's) and a cost model measured on this machine just before the games, as the game does at start-up \
-         (the crowd's shares kept from the rules' model)"
+        "rules (the game's) and a cost model measured on this machine just before each crowd size's games, as the game does \
+         at start-up (its shares in that crowd, the rigid level's up to what the largest budget holds)"
     } else {
         "rules and cost model (the game's)"
     };
@@ -488,9 +500,13 @@ fn report(
             m.p99_over_median()
         );
     }
-    if let Some(lines) = measured_model {
-        report += "\nThe cost model measured before the games (us per creature per 1/30 s):\n\n";
-        for line in lines {
+    for model in measured {
+        let _ = write!(
+            report,
+            "\nThe cost model measured before the games of {} creatures (us per creature per 1/30 s):\n\n",
+            model.creatures
+        );
+        for line in &model.lines {
             let _ = writeln!(report, "- {line}");
         }
     }
