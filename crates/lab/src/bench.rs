@@ -406,9 +406,9 @@ fn per_creature_us(config: &SimConfig, count: u32, policy: LevelPolicy, (warmup,
 /// mix. Where it is a crowd, the cheap levels' and the choice's (see [`crowd_shares`]); else the
 /// file's, for a crowd a new round may bring. Then the rigid level's in play in that crowd (see
 /// [`rigid_in_play`]) at each count of [`RIGID_COUNTS`] up to the first the rules' budget
-/// holds. Kept from a file measured on another machine, these shares priced 100,000 point
-/// masses at three quarters of what they ran, and 350 rigid creatures among 4,000 at 0.57
-/// (2026-11-29).
+/// holds, from the first whose rigid creatures are a fair part of the frame. Kept from a file
+/// measured on another machine, these shares priced 100,000 point masses at three quarters of
+/// what they ran, and 350 rigid creatures among 4,000 at 0.57 (2026-11-29).
 fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> CostModel {
     let effort = (30, 20);
     (model.crowd_shares, model.larger_crowd_shares) = if creatures >= simlod::PARALLEL_MIN_CREATURES {
@@ -418,22 +418,25 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
     };
     model.rigid_shares = Vec::new();
     let [point_mass, hybrid, rigid_us] = mix_us(config, &model, creatures, 0);
-    let holds = (f64::from(config.rules.budget.frame_budget_ms) * 1e3
-        - f64::from(model.overhead_us(creatures as usize))
-        - f64::from(creatures) * point_mass.max(hybrid))
-        / rigid_us.max(1e-9);
+    let rest_us = f64::from(model.overhead_us(creatures as usize)) + f64::from(creatures) * point_mass.max(hybrid);
+    let holds = (f64::from(config.rules.budget.frame_budget_ms) * 1e3 - rest_us) / rigid_us.max(1e-9);
     let mut counts: Vec<u32> = RIGID_COUNTS
         .iter()
         .map(|&r| r.min(creatures))
         .filter(|&r| r > 0)
         .collect();
     counts.dedup();
+    // A count whose rigid creatures are under half the rest of the frame measures the rest's
+    // spread more than them (among 100,000 creatures, 16 rigid ones came out at 0.01 of their
+    // figure, and 11 at 5.8, 2026-11-29): the counts start at the first over it.
+    let last = counts.len().saturating_sub(1);
+    let first = (counts.iter().position(|&r| f64::from(r) * rigid_us >= rest_us / 2.0)).map_or(last, |i| i.min(last));
     let needed = counts
         .iter()
         .position(|&r| f64::from(r) >= holds)
         .map_or(counts.len(), |i| i + 1);
-    counts.truncate(needed.max(1));
-    model.rigid_shares = rigid_shares(config, &model, &counts, |_| creatures, effort);
+    let counts = &counts[first..needed.max(first + 1).min(counts.len())];
+    model.rigid_shares = rigid_shares(config, &model, counts, |_| creatures, effort);
     model
 }
 
