@@ -497,8 +497,7 @@ fn crowd_shares(config: &SimConfig, model: &CostModel, count: u32, (warmup, fram
         ..model.clone()
     };
     let crowd = choice_cost_us(config, &at_count, count, (warmup, frames.div_ceil(3)), false);
-    let floors = in_play(config, &at_count, count, 0.0, (warmup, frames));
-    let floors_us = ((floors.median_us - floors.cheap_us) / f64::from(count)).max(0.0);
+    let floors_us = in_play(config, &at_count, count, 0.0, (warmup, frames)).beyond_the_cheap_us_per_creature(count);
     shares.floors_only = share(floors_us, f64::from(model.floors_only_us_per_creature));
     at_count.crowd_shares = Some(shares);
     let in_play = choice_in_play_us(
@@ -761,6 +760,15 @@ struct InPlay {
     rigid: f64,
 }
 
+impl InPlay {
+    /// What the frames took (their median) beyond the model's figures for the fixed cost, the
+    /// searches and the cheap levels, per creature of `count`: the choice's part of a game
+    /// without rigid creatures, so that the model's parts add up to the frame measured.
+    fn beyond_the_cheap_us_per_creature(&self, count: u32) -> f64 {
+        ((self.median_us - self.cheap_us) / f64::from(count.max(1))).max(0.0)
+    }
+}
+
 /// The scenario's mix of `count` creatures under the budget policy at `room_us` a frame,
 /// priced by `model`, every frame timed after a warm-up, each beside what `model` says of the
 /// levels its creatures ran at (read after the frame) and of its searches.
@@ -846,8 +854,7 @@ fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us
     }
     let [pm, hybrid, _] = mix_us(config, &priced, count, 0);
     let room_us = f64::from(priced.overhead_us(count as usize)) + f64::from(count) * (pm + hybrid) / 2.0;
-    let game = in_play(config, &priced, count, room_us, effort);
-    ((game.median_us - game.cheap_us) / f64::from(count.max(1))).max(0.0)
+    in_play(config, &priced, count, room_us, effort).beyond_the_cheap_us_per_creature(count)
 }
 
 /// The rigid level's cost in play as a share of what `model` says of it (among four times as
