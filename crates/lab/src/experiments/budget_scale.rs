@@ -166,7 +166,7 @@ impl Game {
 
     /// Whether the frame predicted is the mean (else a percentile the adaptive mode keeps).
     fn predicts_the_mean(&self) -> bool {
-        self.adaptive_frames == 0.0 || self.adaptive_percentile == 0.0
+        !keeps_a_percentile(self.adaptive_frames, self.adaptive_percentile)
     }
 
     /// How the adaptive mode ran, in words.
@@ -182,6 +182,12 @@ impl Game {
     fn predicted_within_10_percent(&self) -> bool {
         (self.measured_over_predicted() - 1.0).abs() <= 0.1
     }
+}
+
+/// Whether the adaptive mode, so set, keeps a percentile of the frames at the budget (else the
+/// mean frame: its prediction is of the mean).
+fn keeps_a_percentile(adaptive_frames: f32, adaptive_percentile: f32) -> bool {
+    adaptive_frames > 0.0 && adaptive_percentile > 0.0
 }
 
 fn game(
@@ -217,7 +223,7 @@ fn game(
         frames: frames.len(),
         mean_frame_ms,
         p99_frame_ms: p99_ms(&frames),
-        held_frame_ms: if adaptive_frames > 0.0 && adaptive_percentile > 0.0 {
+        held_frame_ms: if keeps_a_percentile(adaptive_frames, adaptive_percentile) {
             percentile_ms(&frames, adaptive_percentile)
         } else {
             mean_frame_ms
