@@ -12,7 +12,7 @@ use crate::contract::SimClock;
 use crate::contract::{GaitPhase, PlanarState};
 use crate::kind::Creature;
 use crate::lod::BudgetTally;
-use crate::outcome::{Summary, summarize};
+use crate::outcome::{MeasuredFrame, Summary, summarize};
 use crate::plugin::SimPlugin;
 use crate::sense::PuckState;
 
@@ -21,6 +21,8 @@ pub struct HeadlessSim {
     /// The Bevy app: reach its world for anything the run holds.
     pub app: App,
     ticks_per_update: u32,
+    /// Each frame's wall time so far, in seconds.
+    frames_s: Vec<f64>,
 }
 
 impl HeadlessSim {
@@ -44,7 +46,11 @@ impl HeadlessSim {
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(0));
         app.update();
         run_ticks_per_update(app.world_mut(), ticks_per_update);
-        Self { app, ticks_per_update }
+        Self {
+            app,
+            ticks_per_update,
+            frames_s: Vec::new(),
+        }
     }
 
     /// The simulation's clock now.
@@ -53,12 +59,13 @@ impl HeadlessSim {
     }
 
     /// Runs one frame: `ticks_per_decision` fixed ticks. Its wall time is left for the
-    /// budget policy's adaptive mode, which alone reads it.
+    /// budget policy's adaptive mode, which alone reads it, and kept for the summary.
     pub fn advance_frame(&mut self) {
         let start = Instant::now();
         self.app.update();
-        let us = start.elapsed().as_secs_f32() * 1e6;
-        self.app.world_mut().resource_mut::<BudgetTally>().measured_us = Some(us);
+        let seconds = start.elapsed().as_secs_f64();
+        self.frames_s.push(seconds);
+        self.app.world_mut().resource_mut::<BudgetTally>().measured_us = Some((seconds * 1e6) as f32);
     }
 
     /// Runs whole frames until at least `seconds` have been simulated.
@@ -70,9 +77,13 @@ impl HeadlessSim {
         }
     }
 
-    /// What the run did so far, as `simlod run` prints it; `wall_seconds` is the caller's measure.
+    /// What the run did so far, as `simlod run` prints it, with each frame's wall time;
+    /// `wall_seconds` is the caller's measure.
     pub fn summary(&mut self, wall_seconds: f64) -> Summary {
-        summarize(self.app.world_mut(), wall_seconds)
+        Summary {
+            measured_frame: MeasuredFrame::of(&self.frames_s),
+            ..summarize(self.app.world_mut(), wall_seconds)
+        }
     }
 
     /// A digest of the simulated state, bit for bit: creatures by serial, and the puck.

@@ -510,6 +510,40 @@ pub struct PredictedFrame {
     pub slowest_ms: f64,
 }
 
+/// Milliseconds of wall time each frame (1/30 s) took, as the headless runner measured them
+/// outside the simulation: what the prediction is measured against. They differ between
+/// identical runs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct MeasuredFrame {
+    /// The frames measured.
+    pub frames: u64,
+    /// Their mean.
+    pub mean_ms: f64,
+    /// Their median (the upper middle one of an even count).
+    pub median_ms: f64,
+    /// Their 99th percentile, by nearest rank: the slowest of every hundred.
+    pub p99_ms: f64,
+    /// The slowest of them.
+    pub slowest_ms: f64,
+}
+
+impl MeasuredFrame {
+    /// Of frames given in seconds; `None` without any.
+    pub fn of(frames_s: &[f64]) -> Option<Self> {
+        let mut sorted = frames_s.to_vec();
+        sorted.sort_by(f64::total_cmp);
+        let ms = |rank: usize| sorted[rank] * 1e3;
+        let last = sorted.len().checked_sub(1)?;
+        Some(Self {
+            frames: sorted.len() as u64,
+            mean_ms: sorted.iter().sum::<f64>() * 1e3 / sorted.len() as f64,
+            median_ms: ms(sorted.len() / 2),
+            p99_ms: ms(crate::lod::nearest_rank(sorted.len(), 99.0)),
+            slowest_ms: ms(last),
+        })
+    }
+}
+
 /// What a run did, as the command line prints it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
@@ -555,10 +589,26 @@ pub struct Summary {
     pub budget: Option<BudgetSummary>,
     /// Simulated seconds.
     pub sim_seconds: f64,
-    /// Wall-clock seconds; the only field that differs between identical runs.
+    /// Each frame's wall time, where a headless runner measured it (`None` in the game); it
+    /// differs between identical runs, as the two fields after it do.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured_frame: Option<MeasuredFrame>,
+    /// Wall-clock seconds.
     pub wall_seconds: f64,
     /// Simulated seconds per wall-clock second.
     pub realtime_factor: f64,
+}
+
+impl Summary {
+    /// The summary without what the wall clock measured: identical runs give identical ones.
+    pub fn without_wall_clock(self) -> Self {
+        Self {
+            measured_frame: None,
+            wall_seconds: 0.0,
+            realtime_factor: 0.0,
+            ..self
+        }
+    }
 }
 
 /// Reads the counts out of a world (creatures alive now plus those removed).
@@ -604,6 +654,7 @@ pub fn summarize(world: &mut World, wall_seconds: f64) -> Summary {
         respawns: tally.respawns,
         levels,
         sim_seconds,
+        measured_frame: None,
         wall_seconds,
         realtime_factor: if wall_seconds > 0.0 {
             sim_seconds / wall_seconds

@@ -239,6 +239,30 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
         ],
         "--rules does not apply to `simlod record-gait`",
     );
+    refused(
+        &["run", "--policy", "influence", "--adaptive", "30"],
+        "--adaptive does not apply to the influence policy",
+    );
+    refused(
+        &["run", "--policy", "budget", "--adaptive", "0"],
+        "between 1 and 10000 frames",
+    );
+    refused(
+        &[
+            "run",
+            "--policy",
+            "budget",
+            "--adaptive",
+            "30",
+            "--adaptive-percentile",
+            "40",
+        ],
+        "between 50 and 100, got 40",
+    );
+    refused(
+        &["run", "--policy", "budget", "--adaptive-percentile", "99"],
+        "--adaptive",
+    );
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["play", "--frame-budget=-1"], "10000 ms");
@@ -321,6 +345,96 @@ fn the_budget_line_says_when_the_measured_frame_is_over_the_budget() {
         .expect("a budget line");
     assert!(line.contains("over it at 30 of 30 decisions"), "{line}");
     assert!(line.contains("% over the budget") && !line.contains("within"), "{line}");
+}
+
+#[test]
+fn run_says_each_frame_measured_and_when_the_cost_model_is_not_this_machines() {
+    // The shipped model at a hundredth of its figures: frames run far over its prediction.
+    let assets = crate::support::copy_assets("run_stale_cost_model");
+    let file = assets.join("costs.ron");
+    let mut model: simlod::config::CostModel = simlod::config::load_file(&file).unwrap();
+    for costs in model
+        .kinds
+        .iter_mut()
+        .map(|k| &mut k.costs)
+        .chain([&mut model.other_kinds])
+    {
+        costs.point_mass_us_per_frame /= 100.0;
+        costs.hybrid_us_per_frame /= 100.0;
+        costs.rigid_us_per_frame /= 100.0;
+    }
+    model.fixed_us_per_frame /= 100.0;
+    std::fs::write(&file, ron::ser::to_string(&model).unwrap()).unwrap();
+    let assets = assets.to_str().unwrap();
+    let out = simlod(&["run", "--assets", assets, "--seconds", "1", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let frame = &summary["measured_frame"];
+    let ms = |key: &str| frame[key].as_f64().unwrap_or_else(|| panic!("no {key}: {frame}"));
+    assert_eq!(frame["frames"], 30, "one a 1/30 s: {frame}");
+    assert!(
+        0.0 < ms("median_ms") && ms("median_ms") <= ms("p99_ms") && ms("p99_ms") <= ms("slowest_ms"),
+        "{frame}"
+    );
+    let predicted = summary["predicted_frame"]["mean_ms"].as_f64().unwrap();
+    assert!(ms("median_ms") > 1.25 * predicted, "{predicted} ms predicted: {frame}");
+    let out = simlod(&["run", "--assets", assets, "--seconds", "1"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("frame as measured (the wall time of each of its 30 frames)"),
+        "{stdout}"
+    );
+    let hint = stdout
+        .lines()
+        .find(|l| l.contains("times the cost model's prediction"))
+        .unwrap_or_else(|| panic!("no word of the model: {stdout}"));
+    assert!(hint.contains("--calibrate") && hint.contains("costs.ron"), "{hint}");
+}
+
+#[test]
+fn run_with_calibrate_plays_by_a_model_measured_before_it_even_where_the_rules_have_none_yet() {
+    // The rules' model file is gone: a run needs it, a run that measures its own does not.
+    let assets = crate::support::copy_assets("run_calibrate");
+    std::fs::remove_file(assets.join("costs.ron")).unwrap();
+    let assets = assets.to_str().unwrap();
+    let args = [
+        "run",
+        "--assets",
+        assets,
+        "--seconds",
+        "1",
+        "--policy",
+        "budget",
+        "--frame-budget",
+        "1",
+        "--json",
+    ];
+    refused(&args, "costs.ron");
+    let out = simlod(
+        &[
+            &args[..],
+            &["--calibrate", "--adaptive", "30", "--adaptive-percentile", "99"],
+        ]
+        .concat(),
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("the rigid level in play among this many rigid creatures"),
+        "{stderr}"
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    assert_eq!(
+        summary["cost_model"],
+        "measured on this machine before the run, not reproducible"
+    );
+    let budget = &summary["budget"];
+    assert_eq!(budget["adaptive"], true, "{budget}");
+    assert_eq!(budget["adaptive_percentile"], 99.0, "{budget}");
+    // A model of zeros would make every creature rigid: the measured one prices them, and a
+    // millisecond holds a few at most.
+    let rigid = summary["levels_mean"]["rigid"].as_f64().unwrap();
+    assert!(rigid < 40.0, "{summary}");
 }
 
 #[test]

@@ -5,9 +5,10 @@ use clap::Args;
 use std::path::PathBuf;
 
 use crate::scenario::*;
-use simlod::config::{MAX_DURATION_S, SimConfig};
+use simlod::config::{MAX_DURATION_S, MeasuredAnew, SimConfig};
 use simlod::headless;
 use simlod::outcome::{Counts, Key, Summary};
+use simlod_lab::bench::{Calibration, calibrate, cost_model_lines};
 
 #[derive(Args)]
 pub(crate) struct RunArgs {
@@ -19,13 +20,47 @@ pub(crate) struct RunArgs {
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub(crate) json: bool,
+    /// Measure the budget policy's cost model on this machine, in this run's crowd, before
+    /// the run (a few seconds, as the game does at start-up), in place of the rules' file. The
+    /// run's choices then depend on the machine: not reproducible.
+    #[arg(long)]
+    pub(crate) calibrate: bool,
+    /// The budget policy's adaptive mode: its cost model corrected by the frames measured,
+    /// over about this many (1 to 10000). It reads the clock: not reproducible.
+    #[arg(long, allow_negative_numbers = true, value_parser = adaptive_frames)]
+    pub(crate) adaptive: Option<f32>,
+    /// With `--adaptive`, the percentile of those frames kept within the budget (50 to 100;
+    /// 99 keeps the slowest of every hundred), not their mean.
+    #[arg(long, requires = "adaptive", allow_negative_numbers = true, value_parser = adaptive_percentile)]
+    pub(crate) adaptive_percentile: Option<f32>,
+}
+
+fn adaptive_frames(s: &str) -> Result<f32, String> {
+    let v = up_to_ten_thousand(s, "frames")?;
+    if v >= 1.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be between 1 and 10000 frames, got {v}"))
+    }
+}
+
+fn adaptive_percentile(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if (50.0..=100.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be between 50 and 100, got {v}"))
+    }
 }
 
 impl RunArgs {
     /// Simulates the scenario and prints what happened. A flag the run's policy never reads is
     /// refused rather than ignored.
     pub(crate) fn run(&self) -> Result<(), Failure> {
-        let config = self.scenario.load()?;
+        let mut config = self.scenario.load_measuring(MeasuredAnew {
+            cost_model: self.calibrate,
+            ..MeasuredAnew::default()
+        })?;
         let policy = config.scenario.level_policy;
         let unread = [
             (
@@ -40,6 +75,7 @@ impl RunArgs {
                 "--frame-budget",
                 self.scenario.frame_budget.is_some() && !policy.uses_frame_budget(),
             ),
+            ("--adaptive", self.adaptive.is_some() && !policy.uses_frame_budget()),
         ];
         if let Some((flag, _)) = unread.iter().find(|(_, unread)| *unread) {
             return Err(Failure::from(format!(
@@ -47,14 +83,22 @@ impl RunArgs {
                 policy.name()
             )));
         }
+        if let Some(frames) = self.adaptive {
+            config.rules.budget.adaptive_frames = frames;
+            config.rules.budget.adaptive_percentile = self.adaptive_percentile.unwrap_or(0.0);
+        }
+        let mut ran = self.scenario.what_ran(&config);
+        if self.calibrate {
+            config.costs = measure_costs(&config);
+            ran.cost_model = MEASURED_BEFORE_THE_RUN.to_owned();
+        }
         let seconds = self.seconds.unwrap_or(f64::from(config.scenario.duration_s));
         let summary = headless::run(config.clone(), seconds);
-        let ran = self.scenario.what_ran(&config);
         if self.json {
             let mut json = serde_json::to_value(&summary).expect("a summary serialises");
             json["policy"] = ran.policy.into();
             json["rules"] = ran.rules.display().to_string().into();
-            json["cost_model"] = ran.cost_model.display().to_string().into();
+            json["cost_model"] = ran.cost_model.into();
             println!("{json}");
         } else {
             print_summary(self, &summary, &config, &ran);
@@ -63,12 +107,40 @@ impl RunArgs {
     }
 }
 
-/// What a run ran under: its level policy, as the command line names it, and the files of its
-/// level rules and cost model.
+/// What a run ran under: its level policy, as the command line names it, the file of its level
+/// rules, and its cost model's (or [`MEASURED_BEFORE_THE_RUN`]).
 pub(crate) struct WhatRan {
     pub(crate) policy: String,
     pub(crate) rules: PathBuf,
-    pub(crate) cost_model: PathBuf,
+    pub(crate) cost_model: String,
+}
+
+/// How far the median frame may run from the cost model's prediction, either way, before the
+/// summary says the model is not this machine's.
+const STALE_MODEL: f64 = 1.25;
+
+/// The cost model of a run with `--calibrate`, as its summary names it.
+const MEASURED_BEFORE_THE_RUN: &str = "measured on this machine before the run, not reproducible";
+
+/// The cost model measured on this machine in the run's crowd, as the game measures it at
+/// start-up; what it says goes to stderr, so that `--json` stays one object on stdout.
+fn measure_costs(config: &SimConfig) -> simlod::config::CostModel {
+    eprintln!("measuring the budget policy's cost model on this machine, in this run's crowd (--calibrate)");
+    let start = std::time::Instant::now();
+    let model = calibrate(
+        config,
+        Calibration::AtStartUp {
+            creatures: config.scenario.creature_count(),
+        },
+    );
+    eprintln!(
+        "measured in {:.1} s (us per creature per 1/30 s):",
+        start.elapsed().as_secs_f32()
+    );
+    for line in cost_model_lines(&model) {
+        eprintln!("  {line}");
+    }
+    model
 }
 
 pub(crate) fn positive_seconds(s: &str) -> Result<f64, String> {
@@ -100,7 +172,7 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
         "level policy {} (rules {}, cost model {})",
         ran.policy,
         ran.rules.display(),
-        ran.cost_model.display()
+        ran.cost_model
     );
     println!(
         "simulated {:.2} s in {:.3} s of wall time ({:.1}x real time); {} Hz ticks, {} Hz steering",
@@ -127,6 +199,19 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
         "frame as the cost model predicts it from the levels simulated: {:.2} ms on average, {:.2} ms at the slowest",
         s.predicted_frame.mean_ms, s.predicted_frame.slowest_ms
     );
+    if let Some(m) = &s.measured_frame {
+        println!(
+            "frame as measured (the wall time of each of its {} frames): {:.2} ms on average, {:.2} ms the median, {:.2} ms at the 99th percentile, {:.2} ms at the slowest",
+            m.frames, m.mean_ms, m.median_ms, m.p99_ms, m.slowest_ms
+        );
+        let off = m.median_ms / s.predicted_frame.mean_ms.max(1e-9);
+        if !(1.0 / STALE_MODEL..=STALE_MODEL).contains(&off) && ran.cost_model != MEASURED_BEFORE_THE_RUN {
+            println!(
+                "  the median frame ran {off:.2} times the cost model's prediction: the model was measured on another machine or day; --calibrate measures it on this one before the run, and `simlod bench --calibrate` writes it to {}",
+                ran.cost_model
+            );
+        }
+    }
     let switches: Vec<String> = s
         .switches
         .directions()
@@ -162,7 +247,7 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
             String::new()
         };
         // The wall clock, read outside the simulation: what the prediction is measured against.
-        let measured_ms = s.wall_seconds * 1e3 / b.decisions.max(1) as f64;
+        let measured_ms = s.measured_frame.map_or(0.0, |m| m.mean_ms);
         let kept = if measured_ms > f64::from(b.frame_budget_ms) {
             format!(
                 "{:.0} % over the budget",

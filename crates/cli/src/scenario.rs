@@ -113,7 +113,7 @@ impl ScenarioArgs {
                 .rules
                 .clone()
                 .unwrap_or_else(|| self.assets.join(&config.scenario.level_rules)),
-            cost_model: self.assets.join(&config.rules.budget.cost_model),
+            cost_model: self.assets.join(&config.rules.budget.cost_model).display().to_string(),
         }
     }
 
