@@ -345,6 +345,7 @@ fn the_budget_line_says_when_the_measured_frame_is_over_the_budget() {
         .expect("a budget line");
     assert!(line.contains("over it at 30 of 30 decisions"), "{line}");
     assert!(line.contains("% over the budget") && !line.contains("within"), "{line}");
+    assert!(line.contains("at the 99th percentile"), "{line}");
 }
 
 #[test]
