@@ -8,7 +8,7 @@ use crate::scenario::*;
 use simlod::config::{MAX_DURATION_S, MeasuredAnew, SimConfig};
 use simlod::headless;
 use simlod::outcome::{Counts, Key, Summary};
-use simlod_lab::bench::{Calibration, calibrate, cost_model_lines};
+use simlod_lab::bench::calibrate_at_start_up;
 
 #[derive(Args)]
 pub(crate) struct RunArgs {
@@ -126,20 +126,8 @@ const MEASURED_BEFORE_THE_RUN: &str = "measured on this machine before the run, 
 /// start-up; what it says goes to stderr, so that `--json` stays one object on stdout.
 fn measure_costs(config: &SimConfig) -> simlod::config::CostModel {
     eprintln!("measuring the budget policy's cost model on this machine, in this run's crowd (--calibrate)");
-    let start = std::time::Instant::now();
-    let model = calibrate(
-        config,
-        Calibration::AtStartUp {
-            creatures: config.scenario.creature_count(),
-        },
-    );
-    eprintln!(
-        "measured in {:.1} s (us per creature per 1/30 s):",
-        start.elapsed().as_secs_f32()
-    );
-    for line in cost_model_lines(&model) {
-        eprintln!("  {line}");
-    }
+    let (model, said) = calibrate_at_start_up(config);
+    eprintln!("{said}");
     model
 }
 

@@ -110,20 +110,7 @@ pub fn play(options: PlayOptions) -> Result<(), GameError> {
 /// measured on another machine, or on another day, is off by as much as the machines differ.
 fn measure_costs(config: &SimConfig) -> CostModel {
     info!("measuring the budget policy's costs on this machine (frame_budget.calibrate_at_start in {GAME_FILE})");
-    let start = std::time::Instant::now();
-    let model = simlod_lab::bench::calibrate(
-        config,
-        simlod_lab::bench::Calibration::AtStartUp {
-            creatures: config.scenario.creature_count(),
-        },
-    );
-    let mut said = format!(
-        "measured in {:.1} s (us per creature per 1/30 s):",
-        start.elapsed().as_secs_f32()
-    );
-    for line in simlod_lab::bench::cost_model_lines(&model) {
-        said += &format!("\n  {line}");
-    }
+    let (model, said) = simlod_lab::bench::calibrate_at_start_up(config);
     info!("{said}");
     model
 }

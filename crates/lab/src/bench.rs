@@ -388,6 +388,26 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
     }
 }
 
+/// The cost model measured as the game measures it at start-up, in the crowd of `config`'s
+/// scenario, and what it says: how long it took and its lines, for a log or a terminal.
+pub fn calibrate_at_start_up(config: &SimConfig) -> (CostModel, String) {
+    let start = Instant::now();
+    let model = calibrate(
+        config,
+        Calibration::AtStartUp {
+            creatures: config.scenario.creature_count(),
+        },
+    );
+    let mut said = format!(
+        "measured in {:.1} s (us per creature per 1/30 s):",
+        start.elapsed().as_secs_f32()
+    );
+    for line in cost_model_lines(&model) {
+        said += &format!("\n  {line}");
+    }
+    (model, said)
+}
+
 /// The creatures of the scenario's mix a level's cost on one thread is measured among, below a
 /// crowd (see [`simlod::PARALLEL_MIN_CREATURES`]).
 const BELOW_A_CROWD: u32 = 2000;
