@@ -125,8 +125,8 @@ pub struct KindCosts {
 }
 
 /// Wall time of one creature's 1/30 s of simulated motion at each level (steering, collisions
-/// and its model), and of a switch into the rigid level (building its bodies) and into the
-/// hybrid, in microseconds; each 0 to 1,000,000 us (as is the model's fixed cost of a frame).
+/// and its model), and of a switch into the rigid level (building its bodies), in
+/// microseconds; each 0 to 1,000,000 us (as is the model's fixed cost of a frame).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct LevelCosts {
@@ -138,11 +138,6 @@ pub struct LevelCosts {
     pub rigid_us_per_frame: f32,
     /// Once, for a switch into the rigid level.
     pub switch_to_rigid_us: f32,
-    /// Once, for a switch from the point mass into the hybrid level: the creature's row moved
-    /// between the levels' tables. A crowd's point masses coming into view switch by the
-    /// thousand in one frame. 0, as a file without it, leaves it unpriced.
-    #[serde(default)]
-    pub switch_to_hybrid_us: f32,
 }
 
 impl LevelCosts {
@@ -189,7 +184,6 @@ impl LevelCosts {
         v.within("hybrid_us_per_frame", self.hybrid_us_per_frame, 0.0, Self::MOST_US);
         v.within("rigid_us_per_frame", self.rigid_us_per_frame, 0.0, Self::MOST_US);
         v.within("switch_to_rigid_us", self.switch_to_rigid_us, 0.0, Self::MOST_US);
-        v.within("switch_to_hybrid_us", self.switch_to_hybrid_us, 0.0, Self::MOST_US);
     }
 }
 

@@ -65,16 +65,12 @@ pub struct Candidate<'a> {
 
 impl Candidate<'_> {
     /// Predicted microseconds of the frame if the creature is given `level`: the level's cost,
-    /// and the building of its bodies if it goes rigid now, or the move of its row if a point
-    /// mass goes hybrid (so that a crowd's point masses coming into view switch as the budget
-    /// has room for, not by the thousand in one frame). A switch down is not charged: it is
-    /// made where a level's benefit is gone, and charged it would never be made.
+    /// and the building of its bodies if it goes rigid now.
     fn cost_us(&self, level: Lod) -> f32 {
-        let switch = match (self.current, level) {
-            (Lod::Rigid, _) => 0.0,
-            (_, Lod::Rigid) => self.costs.switch_to_rigid_us,
-            (Lod::PointMass, Lod::Hybrid) => self.costs.switch_to_hybrid_us,
-            _ => 0.0,
+        let switch = if level == Lod::Rigid && self.current != Lod::Rigid {
+            self.costs.switch_to_rigid_us
+        } else {
+            0.0
         };
         self.costs.per_frame_us(level) + switch
     }
@@ -1896,7 +1892,6 @@ mod tests {
         hybrid_us_per_frame: 2.0,
         rigid_us_per_frame: 100.0,
         switch_to_rigid_us: 50.0,
-        switch_to_hybrid_us: 0.0,
     };
 
     /// Numbers in [0, 1) from `seed`, the same every run (a linear congruential generator).
@@ -2175,7 +2170,6 @@ mod tests {
             hybrid_us_per_frame: 50.0,
             rigid_us_per_frame: 10.0,
             switch_to_rigid_us: 0.0,
-            switch_to_hybrid_us: 0.0,
         };
         assert!(!costs.rise_with_level() && COSTS.rise_with_level());
         let unsettled = |serial, current, rigid| Candidate {
@@ -2496,32 +2490,6 @@ mod tests {
             (a.predicted_us - (4.0 * 2.0 + 150.0)).abs() < 1e-3 && !a.exceeded,
             "{a:?}"
         );
-    }
-
-    #[test]
-    fn a_point_mass_going_hybrid_is_charged_its_switch_and_a_hybrid_staying_is_not() {
-        // Six creatures in view, the hybrid worth 0.5 each: four point masses and two hybrids.
-        // Each point mass going hybrid costs its level and its switch (1 + 10 us more), so a
-        // budget of the floors and 25 us switches two of them; the hybrids keep theirs for 1 us.
-        let costs = LevelCosts {
-            switch_to_hybrid_us: 10.0,
-            ..COSTS
-        };
-        let at = |serial, current| Candidate {
-            costs,
-            levels: &Lod::ALL[..2],
-            ..candidate(serial, current, 0.0)
-        };
-        let mut cs: Vec<_> = (0..4).map(|i| at(i, Lod::PointMass)).collect();
-        cs.extend((4..6).map(|i| at(i, Lod::Hybrid)));
-        let a = allocate(&mut cs, 6.0 + 2.0 + 2.0 * 11.0 + 3.0, 0.0, 0.0, 0.0, |_| (0.0, ()));
-        assert_eq!(a.levels.iter().filter(|&&l| l == Lod::Hybrid).count(), 4, "{a:?}");
-        assert_eq!(a.levels[4..], [Lod::Hybrid; 2], "{a:?}");
-        assert!((a.predicted_us - (6.0 + 4.0 + 2.0 * 10.0)).abs() < 1e-3, "{a:?}");
-        // Unpriced (a file without the figure), every point mass goes hybrid at once.
-        cs.iter_mut().for_each(|c| c.costs = COSTS);
-        let a = allocate(&mut cs, 33.0, 0.0, 0.0, 0.0, |_| (0.0, ()));
-        assert_eq!(a.levels, [Lod::Hybrid; 6], "{a:?}");
     }
 
     #[test]

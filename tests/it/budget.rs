@@ -17,7 +17,6 @@ const COSTS: LevelCosts = LevelCosts {
     hybrid_us_per_frame: 2.0,
     rigid_us_per_frame: 100.0,
     switch_to_rigid_us: 50.0,
-    switch_to_hybrid_us: 0.0,
 };
 
 /// `hoppers` hoppers under the budget policy with `budget_ms` and the costs above.

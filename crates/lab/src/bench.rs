@@ -14,7 +14,7 @@ use simlod::config::{CostModel, CrowdShares, KindCosts, LevelCosts, RigidShare, 
 use simlod::creature::KindTable;
 use simlod::headless::HeadlessSim;
 use simlod::kind::Creature;
-use simlod::lod::{BudgetTally, LevelPolicy, Lod, SwitchTally};
+use simlod::lod::{BudgetTally, LevelPolicy, Lod};
 
 /// Wall-clock budget of one frame at 30 fps.
 const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
@@ -381,8 +381,7 @@ pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
         Calibration::Full | Calibration::AtStartUp { .. } => 3,
         Calibration::Quick => 1,
     };
-    let mut model = median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>());
-    with_switches_to_hybrid(config, &mut model);
+    let model = median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>());
     match how {
         Calibration::AtStartUp { creatures } => in_the_crowd_that_plays(config, model, creatures),
         Calibration::Full | Calibration::Quick => model,
@@ -573,8 +572,6 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
                 hybrid_us_per_frame: us[1] as f32,
                 rigid_us_per_frame: us[2] as f32,
                 switch_to_rigid_us: switch_us as f32,
-                // Measured once, after the passes (see `with_switches_to_hybrid`).
-                switch_to_hybrid_us: 0.0,
             },
         });
     }
@@ -661,7 +658,6 @@ fn median_model(models: &[CostModel]) -> CostModel {
         hybrid_us_per_frame: median_of(&|m| costs(m).hybrid_us_per_frame),
         rigid_us_per_frame: median_of(&|m| costs(m).rigid_us_per_frame),
         switch_to_rigid_us: median_of(&|m| costs(m).switch_to_rigid_us),
-        switch_to_hybrid_us: median_of(&|m| costs(m).switch_to_hybrid_us),
     };
     let shares_of = |shares: &dyn Fn(&CostModel) -> &CrowdShares| CrowdShares {
         creatures: shares(&models[0]).creatures,
@@ -709,7 +705,6 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
         hybrid_us_per_frame: dearest(|c| c.hybrid_us_per_frame),
         rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
         switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
-        switch_to_hybrid_us: dearest(|c| c.switch_to_hybrid_us),
     }
 }
 
@@ -957,66 +952,6 @@ fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
 /// Worlds built at each level to measure a switch into rigid, in turn.
 const SWITCH_PAIRS: usize = 5;
 
-/// Each kind's switch from the point mass into the hybrid (see `switch_to_hybrid_us`), where it
-/// has both: once, since each measure is already the median of its cycles and a pass costs
-/// a second.
-fn with_switches_to_hybrid(config: &SimConfig, model: &mut CostModel) {
-    let kinds = KindTable::of(config);
-    for entry in &mut model.kinds {
-        let levels = &kinds[config.kind_index(&entry.kind).expect("a kind of the config")].levels;
-        if levels.contains(&Lod::PointMass) && levels.contains(&Lod::Hybrid) {
-            let c = &mut entry.costs;
-            let hybrid_extra_us = f64::from(c.hybrid_us_per_frame - c.point_mass_us_per_frame);
-            let alone = crate::scene::only_kind(config, &entry.kind);
-            c.switch_to_hybrid_us = switch_to_hybrid_us(&alone, SWITCHING, hybrid_extra_us) as f32;
-        }
-    }
-    model.other_kinds = dearest(&model.kinds);
-}
-
-/// The creatures of a kind a switch into the hybrid is measured among.
-const SWITCHING: u32 = 500;
-
-/// A switch between the point mass and the hybrid, in microseconds: `count` creatures of
-/// `config` sent from the one to the other and back ([`HYBRID_SWITCH_CYCLES`] times, each way
-/// given [`FRAMES_EACH_WAY`] frames, so that those in view reach their flight window), what
-/// their frames take beyond the same creatures kept at the point mass stepped beside them
-/// (less `hybrid_extra_us`, a hybrid's cost over its point mass's a frame, while they are
-/// hybrid), over the switches made: the median of the cycles. Both ways are timed, as the
-/// budget sends creatures both ways; it charges only the way up.
-fn switch_to_hybrid_us(config: &SimConfig, count: u32, hybrid_extra_us: f64) -> f64 {
-    let at = |policy| HeadlessSim::new(scaled(config, count, policy));
-    let (mut sim, mut beside) = (at(LevelPolicy::AllPointMass), at(LevelPolicy::AllPointMass));
-    for _ in 0..FRAMES_EACH_WAY {
-        sim.advance_frame();
-        beside.advance_frame();
-    }
-    let switches = |sim: &HeadlessSim| sim.app.world().resource::<SwitchTally>().switches.total();
-    let cycles = (0..HYBRID_SWITCH_CYCLES)
-        .map(|_| {
-            let before = switches(&sim);
-            let mut extra_s = 0.0;
-            for policy in [LevelPolicy::AllHybrid, LevelPolicy::AllPointMass] {
-                sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = policy;
-                for _ in 0..FRAMES_EACH_WAY {
-                    extra_s += timed_frame(&mut sim) - timed_frame(&mut beside);
-                }
-            }
-            let made = (switches(&sim) - before).max(1);
-            let hybrid_us = hybrid_extra_us * f64::from(count) * FRAMES_EACH_WAY as f64;
-            (extra_s * 1e6 - hybrid_us) / made as f64
-        })
-        .collect();
-    median(cycles).max(0.0)
-}
-
-/// Times a crowd is sent to the hybrid and back to measure a switch between them.
-const HYBRID_SWITCH_CYCLES: usize = 3;
-
-/// Frames a crowd is given to switch each way: a hop and more, so that every creature in view
-/// reaches its flight window.
-const FRAMES_EACH_WAY: usize = 15;
-
 /// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
 /// choice's, the crowd's shares, and the rigid level's in play among more rigid creatures.
 pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
@@ -1024,13 +959,8 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
         .map(|k| {
             let c = &k.costs;
             format!(
-                "{:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}, to hybrid {:.1}",
-                k.kind,
-                c.point_mass_us_per_frame,
-                c.hybrid_us_per_frame,
-                c.rigid_us_per_frame,
-                c.switch_to_rigid_us,
-                c.switch_to_hybrid_us
+                "{:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
+                k.kind, c.point_mass_us_per_frame, c.hybrid_us_per_frame, c.rigid_us_per_frame, c.switch_to_rigid_us
             )
         })
         .collect();
