@@ -268,7 +268,7 @@ impl MachineSpread {
 
 /// Each thread's memory in the fixed job, 8-byte words: 16 MiB, beyond the caches, since a
 /// frame's work reads and writes memory and meets the machine's other tenants there. Walked
-/// ALU-only, the job ran 1.05 to 1.2 times its median at its 99th percentile on one core here,
+/// ALU-only, the job ran 1.04 to 1.4 times its median at its 99th percentile on one core here,
 /// and through memory 1.6 to 1.7, as the games did.
 const JOB_WORDS: usize = 2 << 20;
 
