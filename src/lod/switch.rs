@@ -18,7 +18,7 @@ use crate::contract::GaitPose;
 use crate::contract::{CollisionRecord, Counts, SwitchCounts};
 use crate::contract::{DENSE, SimClock, SimStage, SimStart};
 use crate::contract::{GaitPhase, PlanarState};
-use crate::kind::{Creature, KindTable};
+use crate::kind::{Creature, KindParams, KindTable};
 use crate::models::point_mass::FrameStep;
 
 /// A creature changed level.
@@ -100,14 +100,47 @@ fn switch_levels(
         let may_be_forced = rules_move_levels && lod != Lod::Rigid && record.touching.iter().any(|&t| t);
         choice.wanted != lod || may_be_forced
     };
+    // Under a fixed policy ("every creature at the point-mass level") a collision does not
+    // overrule it; under the budget policy only a rigid level the budget paid for skips the
+    // window.
+    let forced = |kind: &KindParams, lod: Lod, choice: &LevelChoice, record: &CollisionRecord| {
+        rules_move_levels
+            && lod != Lod::Rigid
+            && record.touching.iter().any(|&t| t)
+            && kind.best_level(Lod::Rigid) == Lod::Rigid
+            && (policy != LevelPolicy::Budget || choice.wanted == Lod::Rigid)
+    };
+    let unseen = |kind: &KindParams, state: &PlanarState| !camera.shows(kind, state);
+    let in_window = |gait: &GaitPhase| gait.flight_progress().is_some_and(|p| (open..=close).contains(&p));
+    // A creature waiting out of view for its window is passed by until it is in it: no one
+    // sees its switch, so no drawing is kept for its blend. A crowd's hybrids leaving the view
+    // wait by the hundred: 20,000 sent to the point mass at once took 590 ms of frames until
+    // the last had switched when each was looked up and drawn at every tick, 316 ms passed by
+    // (2026-11-29).
+    let waits_unseen =
+        |kind: &KindParams, lod: Lod, choice: &LevelChoice, gait, record, state, before: &DrawnBefore| {
+            let forced = forced(kind, lod, choice, record);
+            !forced
+                && choice.wanted != lod
+                && before.0.is_none()
+                && lod != Lod::PointMass
+                && !in_window(gait)
+                && unseen(kind, state)
+        };
     let (attend, waiting) = &mut *kept;
     attend.clear();
-    for (entity, _, lod, choice, _, record, _, frame) in creatures.as_readonly().contiguous_iter().expect(DENSE) {
+    for (entity, creature, lod, choice, gait, record, (state, _, before), frame) in
+        creatures.as_readonly().contiguous_iter().expect(DENSE)
+    {
         let mut i = 0;
         while let Some(next) = FrameStep::next_not_behind(frame, i) {
             i = next;
-            if attends(lod[i], &choice[i], &record[i]) {
-                attend.push(entity[i]);
+            let (lod, choice, record) = (lod[i], &choice[i], &record[i]);
+            if attends(lod, choice, record) {
+                let kind = &kinds[creature[i].kind];
+                if !waits_unseen(kind, lod, choice, &gait[i], record, &state[i], &before[i]) {
+                    attend.push(entity[i]);
+                }
             }
             i += 1;
         }
@@ -127,18 +160,7 @@ fn switch_levels(
             continue;
         };
         let kind = &kinds[creature.kind];
-        // Left unposed at its frame's catch-up, if nothing read it then.
-        if frame.pose_stale {
-            frame.pose_now(kind, lod, state, gait, &mut pose);
-        }
-        // Under a fixed policy ("every creature at the point-mass level") a collision does not
-        // overrule it; under the budget policy only a rigid level the budget paid for skips
-        // the window.
-        let forced = rules_move_levels
-            && lod != Lod::Rigid
-            && record.touching.iter().any(|&t| t)
-            && kind.best_level(Lod::Rigid) == Lod::Rigid
-            && (policy != LevelPolicy::Budget || choice.wanted == Lod::Rigid);
+        let forced = forced(kind, lod, &choice, record);
         let target = if forced { Lod::Rigid } else { choice.wanted };
         if target == lod {
             if before.0.is_some() {
@@ -146,13 +168,22 @@ fn switch_levels(
             }
             continue;
         }
+        let unseen = unseen(kind, state);
+        let skips_window = forced || (unseen && lod == Lod::PointMass);
+        if !skips_window && !in_window(gait) && unseen {
+            // Out of view since it last waited in it: its drawing is let go.
+            before.0 = None;
+            continue;
+        }
+        // Left unposed at its frame's catch-up, if nothing read it then.
+        if frame.pose_stale {
+            frame.pose_now(kind, lod, state, gait, &mut pose);
+        }
         // What is drawn now (as the last tick left it), blended and by the model alone.
         let model = Drawn::of(state, &pose);
         let seen = (blends.get(entity).map_or(model, |b| b.apply(&model, now)), model);
         let progress = gait.flight_progress();
-        let unseen = !camera.shows(kind, state);
-        let skips_window = forced || (unseen && lod == Lod::PointMass);
-        if !skips_window && !progress.is_some_and(|p| (open..=close).contains(&p)) {
+        if !skips_window && !in_window(gait) {
             before.0 = Some(seen);
             waiting.push(entity);
             continue;

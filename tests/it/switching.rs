@@ -10,7 +10,7 @@ use simlod::config::SimConfig;
 use simlod::creature::{Creature, PlanarState};
 use simlod::gait::GaitPose;
 use simlod::headless::HeadlessSim;
-use simlod::lod::{Drawn, LevelPolicy, LevelSwitched, LevelsSettled, Lod, SimCamera};
+use simlod::lod::{Drawn, DrawnBefore, LevelChoice, LevelPolicy, LevelSwitched, LevelsSettled, Lod, SimCamera};
 use simlod::models::rigid::{RigidBodies, RigidPart};
 use simlod::outcome::CollisionRecord;
 use simlod::{SimClock, SimStage};
@@ -485,6 +485,41 @@ fn a_policy_changed_during_a_game_takes_every_creature_to_its_level_then_rests()
     sim.run_for(2.0);
     assert_eq!(sim.app.world().resource::<Watch>().seen.len(), switches);
     assert!(levels(&mut sim).iter().all(|l| *l == Lod::PointMass));
+}
+
+#[test]
+fn a_creature_waiting_for_its_window_keeps_its_drawing_only_where_the_camera_sees_it() {
+    let mut sim = watched(influence_config());
+    sim.run_for(3.0);
+    sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = LevelPolicy::AllPointMass;
+    let (mut seen_waiting, mut unseen_waiting) = (0, 0);
+    for _ in 0..60 {
+        sim.advance_frame();
+        let world = sim.app.world_mut();
+        let camera = *world.resource::<SimCamera>();
+        let kinds = world.resource::<simlod::kind::KindTable>().clone();
+        let mut creatures = world.query::<(&Creature, &Lod, &LevelChoice, &PlanarState, &DrawnBefore)>();
+        for (creature, &lod, choice, state, before) in creatures.iter(world) {
+            if choice.wanted == lod {
+                assert!(before.0.is_none(), "a creature at its level keeps no drawing");
+            } else if camera.shows(&kinds[creature.kind], state) {
+                seen_waiting += 1;
+                // In view, the switch continues the drawn motion of the tick before.
+                assert!(
+                    before.0.is_some(),
+                    "{} waits in view without its drawing",
+                    creature.serial
+                );
+            } else {
+                unseen_waiting += 1;
+                assert!(before.0.is_none(), "{} keeps a drawing no one sees", creature.serial);
+            }
+        }
+    }
+    assert!(
+        seen_waiting >= 10 && unseen_waiting >= 10,
+        "{seen_waiting} in view, {unseen_waiting} out of it"
+    );
 }
 
 #[test]
