@@ -607,6 +607,10 @@ fn the_budget_at_every_crowd_size_can_price_each_sizes_games_by_a_model_measured
         );
         let first = format!("\n- {}\n", lines[0].as_str().unwrap());
         assert!(said.contains(&first), "the report lists it: {said}");
+        // With how long the game would wait for it at start-up.
+        let seconds = model["seconds"].as_f64().unwrap_or_else(|| panic!("{model}"));
+        let heading = format!("games of {} creatures, in {seconds:.1} s (", model["creatures"]);
+        assert!(seconds > 0.0 && said.contains(&heading), "{heading}: {said}");
         // Its rigid level measured among that crowd's own creatures: never more rigid ones
         // than it has.
         let rigid = lines.last().unwrap().as_str().unwrap();

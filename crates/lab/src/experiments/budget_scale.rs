@@ -242,6 +242,8 @@ fn game(
 #[derive(Clone, Debug, Serialize)]
 struct MeasuredModel {
     creatures: u32,
+    /// How long measuring it took, s: the game's wait at start-up for that crowd.
+    seconds: f64,
     /// What it says, a line each (see [`cost_model_lines`]).
     lines: Vec<String>,
 }
@@ -335,12 +337,14 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             // largest budget holds.
             let mut largest = config.clone();
             largest.rules.budget.frame_budget_ms = s.budgets_ms.iter().copied().fold(0.0, f32::max);
+            let start = Instant::now();
             measured = SimConfig {
                 costs: calibrate(&largest, Calibration::AtStartUp { creatures: n }),
                 ..config.clone()
             };
             measured_models.push(MeasuredModel {
                 creatures: n,
+                seconds: start.elapsed().as_secs_f64(),
                 lines: cost_model_lines(&measured.costs),
             });
             &measured
@@ -555,8 +559,8 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, me
     for model in measured {
         let _ = write!(
             report,
-            "\nThe cost model measured before the games of {} creatures (us per creature per 1/30 s):\n\n",
-            model.creatures
+            "\nThe cost model measured before the games of {} creatures, in {:.1} s (us per creature per 1/30 s):\n\n",
+            model.creatures, model.seconds
         );
         for line in &model.lines {
             let _ = writeln!(report, "- {line}");
