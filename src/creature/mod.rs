@@ -12,7 +12,7 @@ use rand::RngExt;
 use crate::config::SimConfig;
 
 use crate::contract::GaitPose;
-use crate::contract::Lod;
+use crate::contract::{AtPointMass, Lod};
 use crate::contract::{SimStart, StartStage, WorldRng};
 
 /// Hands out creature serials, and keeps where creatures were placed since the last steering
@@ -163,7 +163,8 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
             .kind_index(&group.kind)
             .expect("kinds are resolved when the config loads");
         let radius = config.kinds[kind].body.radius_m;
-        // As point masses: each enters its level once all are placed (`lod::select`).
+        // As point masses (spawned with their marker, below): each enters its level once all are
+        // placed (`lod::select`).
         let level = Lod::PointMass;
         for _ in 0..group.count {
             // The puck starts at the centre.
@@ -195,7 +196,9 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
     // The kinds first: a creature's level builds its model from them as it is spawned.
     commands.insert_resource(kinds);
     commands.insert_resource(newcomers);
-    commands.spawn_batch(batch);
+    // With their level's marker: the marker the level's hook would add moved each creature to
+    // another table, half of building 100,000 point masses (2026-11-29).
+    commands.spawn_batch(batch.into_iter().map(|creature| (creature, AtPointMass)));
 }
 
 pub(super) fn plugin(app: &mut App) {
