@@ -84,12 +84,17 @@ impl Lod {
 }
 
 /// Marks a creature at the point-mass level (paper 3.3). The level markers make the queries
-/// of different levels provably disjoint, so their systems cannot race.
+/// of different levels provably disjoint, so their systems cannot race. The point mass's and
+/// the hybrid's are kept apart from the creature's table (no loop filters by them): a switch
+/// between the two moves no row, and a crowd stays in its spawned order. 20,000 point masses
+/// entering the hybrid level at once took a frame of 51 ms against 90 (2026-11-29).
 #[derive(Component, Clone, Copy, Debug, Default)]
+#[component(storage = "SparseSet")]
 pub struct AtPointMass;
 
-/// Marks a creature at the hybrid level (paper 3.2).
+/// Marks a creature at the hybrid level (paper 3.2); kept as [`AtPointMass`] is.
 #[derive(Component, Clone, Copy, Debug, Default)]
+#[component(storage = "SparseSet")]
 pub struct AtHybrid;
 
 /// Marks a creature at the rigid level (paper 3.1): adding it builds the bodies, removing it

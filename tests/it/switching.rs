@@ -600,3 +600,35 @@ fn no_creature_flickers_across_the_edge_of_the_view_while_the_camera_holds_still
         "flickers across the view's edge, the camera still"
     );
 }
+
+#[test]
+fn a_switch_between_the_cheap_levels_leaves_the_creature_where_it_is_in_memory() {
+    // The point mass and the hybrid share one body and one table: a crowd's creatures stay in
+    // the order they were spawned in (near in the court, near in memory), and a burst of
+    // switches moves no rows.
+    let mut config = default_config();
+    config.scenario.level_policy = LevelPolicy::AllPointMass;
+    let mut sim = HeadlessSim::new(config);
+    sim.advance_frame();
+    let rows = |sim: &mut HeadlessSim| {
+        let world = sim.app.world_mut();
+        let mut creatures = world.query::<(Entity, &Creature, &Lod)>();
+        let mut rows: Vec<_> = (creatures.iter(world))
+            .map(|(entity, creature, &lod)| {
+                let at = world.entity(entity).location();
+                (creature.serial, lod, (at.table_id, at.table_row))
+            })
+            .collect();
+        rows.sort_by_key(|r| r.0);
+        rows
+    };
+    let before = rows(&mut sim);
+    sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = LevelPolicy::AllHybrid;
+    sim.run_for(1.0);
+    let after = rows(&mut sim);
+    assert_eq!(before.len(), after.len());
+    for ((serial, was, place), (_, now, place_now)) in before.iter().zip(&after) {
+        assert_eq!((*was, *now), (Lod::PointMass, Lod::Hybrid), "creature {serial}");
+        assert_eq!(place, place_now, "creature {serial} moved in memory at its switch");
+    }
+}
