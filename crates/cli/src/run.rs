@@ -21,8 +21,9 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     pub(crate) json: bool,
     /// Measure the budget policy's cost model on this machine, in this run's crowd, before
-    /// the run (a second or two, up to about 5 s for 100,000 creatures, as the game does at start-up), in place of the rules' file. The
-    /// run's choices then depend on the machine: not reproducible.
+    /// the run (a second or two, up to about 5 s for 100,000 creatures, as the game does at
+    /// start-up), in place of the rules' file. The run's choices then depend on the machine:
+    /// not reproducible.
     #[arg(long)]
     pub(crate) calibrate: bool,
     /// The budget policy's adaptive mode: its cost model corrected by the frames measured,
