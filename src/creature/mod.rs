@@ -196,9 +196,7 @@ pub(crate) fn spawn_creatures(mut commands: Commands, config: Res<SimConfig>, mu
     // The kinds first: a creature's level builds its model from them as it is spawned.
     commands.insert_resource(kinds);
     commands.insert_resource(newcomers);
-    // With their level's marker, which the level's hook would otherwise add to each one by one
-    // (while the markers were kept in the creatures' table, that moved every creature to
-    // another table: half of building 100,000 point masses, 2026-11-29).
+    // With their level's marker, which the level's hook would otherwise add to each one by one.
     commands.spawn_batch(batch.into_iter().map(|creature| (creature, AtPointMass)));
 }
 
