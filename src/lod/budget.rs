@@ -65,14 +65,10 @@ pub struct Candidate<'a> {
 
 impl Candidate<'_> {
     /// Predicted microseconds of the frame if the creature is given `level`: the level's cost,
-    /// and the building of its bodies if it goes rigid now.
+    /// and its switch if it goes rigid now (the building of its bodies) or to the other cheap
+    /// level.
     fn cost_us(&self, level: Lod) -> f32 {
-        let switch = if level == Lod::Rigid && self.current != Lod::Rigid {
-            self.costs.switch_to_rigid_us
-        } else {
-            0.0
-        };
-        self.costs.per_frame_us(level) + switch
+        self.costs.per_frame_us(level) + self.costs.switch_us(self.current, level)
     }
 
     /// Predicted microseconds of the frame while the creature moves toward `level`: until its
@@ -1526,7 +1522,12 @@ fn decide(
     let costs = config.costs_by_kind(rigid as u32);
     let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
-        if dwelling { lod } else { kinds[c.kind].levels[0] }
+        let lowest = kinds[c.kind].levels[0];
+        if dwelling || costs[c.kind].holds(lod, lowest) {
+            lod
+        } else {
+            lowest
+        }
     };
     // Each kind at each floor and level, once.
     let at_floor: Vec<[[AtFloor; 3]; 3]> = (kinds.0.iter().zip(&costs))
@@ -1892,6 +1893,7 @@ mod tests {
         hybrid_us_per_frame: 2.0,
         rigid_us_per_frame: 100.0,
         switch_to_rigid_us: 50.0,
+        cheap_switch_us: 0.0,
     };
 
     /// Numbers in [0, 1) from `seed`, the same every run (a linear congruential generator).
@@ -2170,6 +2172,7 @@ mod tests {
             hybrid_us_per_frame: 50.0,
             rigid_us_per_frame: 10.0,
             switch_to_rigid_us: 0.0,
+            cheap_switch_us: 0.0,
         };
         assert!(!costs.rise_with_level() && COSTS.rise_with_level());
         let unsettled = |serial, current, rigid| Candidate {

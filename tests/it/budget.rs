@@ -2,14 +2,17 @@
 //! contact comes soonest, the same files give the same run, and a budget too small for even
 //! the cheapest levels is said, not refused.
 
+use bevy::ecs::message::Messages;
 use bevy::prelude::*;
+use std::collections::HashSet;
 
 use crate::support::*;
 use simlod::arena::PuckState;
 use simlod::config::{CostModel, CrowdShares, LevelCosts, RigidShare, SimConfig};
+use simlod::contract::SwitchCounts;
 use simlod::creature::{Creature, PlanarState};
 use simlod::headless::HeadlessSim;
-use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, Lod};
+use simlod::lod::{BudgetTally, LevelChoice, LevelPolicy, LevelSwitched, Lod};
 
 /// Costs set here, so that the tests do not move with the machine's calibration.
 const COSTS: LevelCosts = LevelCosts {
@@ -17,6 +20,7 @@ const COSTS: LevelCosts = LevelCosts {
     hybrid_us_per_frame: 2.0,
     rigid_us_per_frame: 100.0,
     switch_to_rigid_us: 50.0,
+    cheap_switch_us: 0.0,
 };
 
 /// `hoppers` hoppers under the budget policy with `budget_ms` and the costs above.
@@ -540,4 +544,44 @@ fn a_budget_cut_below_the_cheapest_levels_sends_the_rigid_to_their_floors_and_ho
             assert_eq!(choice.wanted, Lod::Hybrid, "creature {serial}");
         }
     }
+}
+
+#[test]
+fn a_hybrid_whose_switch_down_costs_more_than_it_saves_is_kept_hybrid_as_the_view_moves_on() {
+    // 30 hoppers with room for a few rigid ones: the creatures in the view's reach are given
+    // the hybrid level, and the view follows one creature about the court. Counted: the
+    // switches of creatures the budget has chosen for (a creature respawned after a fall
+    // keeps the level it fell at and has no choice until the next decision).
+    let switches = |cheap_switch_us: f32| {
+        let mut config = budget_scene(30, 0.5);
+        config.costs.other_kinds.cheap_switch_us = cheap_switch_us;
+        let mut sim = HeadlessSim::new(config);
+        let (mut chosen, mut counts) = (HashSet::new(), SwitchCounts::default());
+        for _ in 0..(15 * 30) {
+            sim.advance_frame();
+            let world = sim.app.world_mut();
+            for s in world
+                .resource::<Messages<LevelSwitched>>()
+                .iter_current_update_messages()
+            {
+                if chosen.contains(&s.serial) {
+                    counts.count(s.from, s.to);
+                }
+            }
+            chosen = world.query::<&Creature>().iter(world).map(|c| c.serial).collect();
+        }
+        counts
+    };
+    // Free, a switch down saves the hybrid's 1 us over the point mass's: hybrids leaving the
+    // view's reach go down.
+    let free = switches(0.0);
+    assert!(free.between(Lod::Hybrid, Lod::PointMass) > 0, "{free:?}");
+    // At 5 us, it costs more than the 1 us it saves: not one goes down, and fewer come up.
+    let priced = switches(5.0);
+    assert_eq!(priced.between(Lod::Hybrid, Lod::PointMass), 0, "{priced:?}");
+    assert!(priced.between(Lod::PointMass, Lod::Hybrid) > 0, "{priced:?}");
+    assert!(
+        priced.between(Lod::PointMass, Lod::Hybrid) < free.between(Lod::PointMass, Lod::Hybrid),
+        "{priced:?} against {free:?}"
+    );
 }

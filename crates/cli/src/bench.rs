@@ -29,7 +29,7 @@ pub(crate) struct BenchArgs {
     /// plays under a 30 ms budget, and with room for every step and no searches.
     #[arg(long, conflicts_with_all = ["calibrate", "level"])]
     pub(crate) choice: bool,
-    /// Measure the budget policy's cost model (each kind's levels and its switch into rigid)
+    /// Measure the budget policy's cost model (each kind's levels and its switches)
     /// and write it to the file the level rules name (`budget.cost_model`), or to `--out`.
     #[arg(long)]
     pub(crate) calibrate: bool,
@@ -96,7 +96,7 @@ impl BenchArgs {
             println!("{}", serde_json::to_string(&model).expect("a cost model serialises"));
         } else {
             println!(
-                "wrote the cost model to {} (us per creature per 1/30 s; us per switch into rigid):",
+                "wrote the cost model to {} (us per creature per 1/30 s; us per switch):",
                 out.display()
             );
             for line in simlod_lab::bench::cost_model_lines(&model) {

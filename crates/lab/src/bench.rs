@@ -14,7 +14,7 @@ use simlod::config::{CostModel, CrowdShares, KindCosts, LevelCosts, RigidShare, 
 use simlod::creature::KindTable;
 use simlod::headless::HeadlessSim;
 use simlod::kind::Creature;
-use simlod::lod::{BudgetTally, LevelPolicy, Lod};
+use simlod::lod::{BudgetTally, LevelPolicy, Lod, SwitchTally};
 
 /// Wall-clock budget of one frame at 30 fps.
 const FRAME_BUDGET_S: f64 = 1.0 / 30.0;
@@ -569,6 +569,11 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         } else {
             0.0
         };
+        let cheap_switch_us = if levels.contains(&Lod::PointMass) && levels.contains(&Lod::Hybrid) {
+            cheap_switch_us(&alone, cheap_count, warmup)
+        } else {
+            0.0
+        };
         entries.push(KindCosts {
             kind: def.name.clone(),
             costs: LevelCosts {
@@ -576,6 +581,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
                 hybrid_us_per_frame: us[1] as f32,
                 rigid_us_per_frame: us[2] as f32,
                 switch_to_rigid_us: switch_us as f32,
+                cheap_switch_us: cheap_switch_us as f32,
             },
         });
     }
@@ -662,6 +668,7 @@ fn median_model(models: &[CostModel]) -> CostModel {
         hybrid_us_per_frame: median_of(&|m| costs(m).hybrid_us_per_frame),
         rigid_us_per_frame: median_of(&|m| costs(m).rigid_us_per_frame),
         switch_to_rigid_us: median_of(&|m| costs(m).switch_to_rigid_us),
+        cheap_switch_us: median_of(&|m| costs(m).cheap_switch_us),
     };
     let shares_of = |shares: &dyn Fn(&CostModel) -> &CrowdShares| CrowdShares {
         creatures: shares(&models[0]).creatures,
@@ -709,6 +716,7 @@ fn dearest(kinds: &[KindCosts]) -> LevelCosts {
         hybrid_us_per_frame: dearest(|c| c.hybrid_us_per_frame),
         rigid_us_per_frame: dearest(|c| c.rigid_us_per_frame),
         switch_to_rigid_us: dearest(|c| c.switch_to_rigid_us),
+        cheap_switch_us: dearest(|c| c.cheap_switch_us),
     }
 }
 
@@ -956,6 +964,49 @@ fn switch_cost_us(config: &SimConfig, count: u32, below: Lod) -> f64 {
 /// Worlds built at each level to measure a switch into rigid, in turn.
 const SWITCH_PAIRS: usize = 5;
 
+/// What a switch between the cheap levels costs, us: `count` point masses of `config`'s mix
+/// sent to the hybrid level at once (those out of view need not wait for their flight window),
+/// the frame they switch in over the median of the three before, shared among its switches. The
+/// median of [`CHEAP_SWITCH_BURSTS`], each after the crowd has gone back down.
+fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize) -> f64 {
+    let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
+    let policy = |sim: &mut HeadlessSim, policy| {
+        sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = policy;
+    };
+    let switches = |sim: &HeadlessSim| sim.app.world().resource::<SwitchTally>().switches.total();
+    for _ in 0..warmup {
+        sim.advance_frame();
+    }
+    let mut bursts = Vec::new();
+    for _ in 0..CHEAP_SWITCH_BURSTS {
+        let before_s = median((0..3).map(|_| timed_frame(&mut sim)).collect());
+        let (switched, start) = (switches(&sim), Instant::now());
+        policy(&mut sim, LevelPolicy::AllHybrid);
+        sim.advance_frame();
+        let burst_s = start.elapsed().as_secs_f64();
+        let n = switches(&sim) - switched;
+        if n > 0 {
+            bursts.push((burst_s - before_s) * 1e6 / n as f64);
+        }
+        // Hybrids wait for their window to go down: a hop is well within a second.
+        policy(&mut sim, LevelPolicy::AllPointMass);
+        for _ in 0..BACK_DOWN_FRAMES {
+            sim.advance_frame();
+        }
+    }
+    if bursts.is_empty() {
+        0.0
+    } else {
+        median(bursts).max(0.0)
+    }
+}
+
+/// Bursts of switches between the cheap levels timed.
+const CHEAP_SWITCH_BURSTS: usize = 5;
+
+/// Frames after a burst for its hybrids to go back down: a second and a half.
+const BACK_DOWN_FRAMES: usize = 45;
+
 /// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
 /// choice's, the crowd's shares, and the rigid level's in play among more rigid creatures.
 pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
@@ -963,8 +1014,13 @@ pub fn cost_model_lines(model: &CostModel) -> Vec<String> {
         .map(|k| {
             let c = &k.costs;
             format!(
-                "{:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}",
-                k.kind, c.point_mass_us_per_frame, c.hybrid_us_per_frame, c.rigid_us_per_frame, c.switch_to_rigid_us
+                "{:<8} point mass {:.3}, hybrid {:.3}, rigid {:.1}; switch to rigid {:.1}, between the cheap levels {:.2}",
+                k.kind,
+                c.point_mass_us_per_frame,
+                c.hybrid_us_per_frame,
+                c.rigid_us_per_frame,
+                c.switch_to_rigid_us,
+                c.cheap_switch_us
             )
         })
         .collect();
@@ -998,6 +1054,6 @@ pub fn costs_file_text(model: &CostModel, command: &str) -> String {
     let pretty = ron::ser::PrettyConfig::new().depth_limit(3).struct_names(false);
     let body = ron::ser::to_string_pretty(model, pretty).expect("a cost model serialises");
     format!(
-        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level, of a frame whatever its creatures (the court, the\n// puck, the schedule) and of the budget policy's choice per creature (and where only the\n// floors fit) and per creature it searches for contacts, in microseconds (medians), and the\n// shares of those costs in crowds and among many rigid creatures, measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
+        "// The budget policy's cost model: wall time per creature per 1/30 s of motion at each\n// level, of a switch into the rigid level and of one between the point mass and the hybrid,\n// of a frame whatever its creatures (the court, the puck, the schedule) and of the budget\n// policy's choice per creature (and where only the floors fit) and per creature it searches\n// for contacts, in microseconds (medians), and the shares of those costs in crowds and among\n// many rigid creatures, measured by:\n//     {command}\n// Run it again on the machine that plays; `other_kinds` is what a kind not listed costs.\n{body}\n"
     )
 }
