@@ -570,7 +570,12 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
             0.0
         };
         let cheap_switch_us = if levels.contains(&Lod::PointMass) && levels.contains(&Lod::Hybrid) {
-            cheap_switch_us(&alone, cheap_count, warmup)
+            cheap_switch_us(
+                &alone,
+                cheap_count,
+                warmup,
+                if how == Calibration::Full { 5 } else { 3 },
+            )
         } else {
             0.0
         };
@@ -967,8 +972,9 @@ const SWITCH_PAIRS: usize = 5;
 /// What a switch between the cheap levels costs, us: `count` point masses of `config`'s mix
 /// sent to the hybrid level at once (those out of view need not wait for their flight window),
 /// the frame they switch in over the median of the three before, shared among its switches. The
-/// median of [`CHEAP_SWITCH_BURSTS`], each after the crowd has gone back down.
-fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize) -> f64 {
+/// median of `bursts`, each after a hop's frames at the point mass (those still hybrid then do
+/// not switch in the next burst, nor count).
+fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize, bursts: usize) -> f64 {
     let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
     let policy = |sim: &mut HeadlessSim, policy| {
         sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = policy;
@@ -977,8 +983,8 @@ fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize) -> f64 {
     for _ in 0..warmup {
         sim.advance_frame();
     }
-    let mut bursts = Vec::new();
-    for _ in 0..CHEAP_SWITCH_BURSTS {
+    let mut per_switch = Vec::new();
+    for _ in 0..bursts {
         let before_s = median((0..3).map(|_| timed_frame(&mut sim)).collect());
         let (switched, start) = (switches(&sim), Instant::now());
         policy(&mut sim, LevelPolicy::AllHybrid);
@@ -986,26 +992,23 @@ fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize) -> f64 {
         let burst_s = start.elapsed().as_secs_f64();
         let n = switches(&sim) - switched;
         if n > 0 {
-            bursts.push((burst_s - before_s) * 1e6 / n as f64);
+            per_switch.push((burst_s - before_s) * 1e6 / n as f64);
         }
-        // Hybrids wait for their window to go down: a hop is well within a second.
+        // Hybrids wait for their window to go down.
         policy(&mut sim, LevelPolicy::AllPointMass);
         for _ in 0..BACK_DOWN_FRAMES {
             sim.advance_frame();
         }
     }
-    if bursts.is_empty() {
+    if per_switch.is_empty() {
         0.0
     } else {
-        median(bursts).max(0.0)
+        median(per_switch).max(0.0)
     }
 }
 
-/// Bursts of switches between the cheap levels timed.
-const CHEAP_SWITCH_BURSTS: usize = 5;
-
-/// Frames after a burst for its hybrids to go back down: a second and a half.
-const BACK_DOWN_FRAMES: usize = 45;
+/// Frames after a burst for its hybrids to go back down: half a second, about a hop.
+const BACK_DOWN_FRAMES: usize = 15;
 
 /// What a cost model says, a line each: every kind's levels, the frame's fixed cost and the
 /// choice's, the crowd's shares, and the rigid level's in play among more rigid creatures.
