@@ -1502,7 +1502,8 @@ impl Allocation<f32> {
 /// Creatures dealt to a core at a time by the budget's choice.
 const DEALT_BLOCK: usize = 1024;
 
-/// The allocation for every creature now, in the query's order.
+/// The allocation for every creature now, in the query's order; `starting`, for a new world's
+/// creatures, built at the levels it gives them.
 fn decide(
     now_s: f32,
     config: &SimConfig,
@@ -1510,6 +1511,7 @@ fn decide(
     scene: &Scene,
     creatures: &Creatures,
     budget_us: f32,
+    starting: bool,
 ) -> Allocation<f32> {
     let readonly = creatures.as_readonly();
     let tables = Tables::of(&readonly);
@@ -1519,7 +1521,14 @@ fn decide(
         .iter()
         .map(|t| t.2.iter().filter(|&&l| l == Lod::Rigid).count())
         .sum::<usize>();
-    let costs = config.costs_by_kind(rigid as u32);
+    let mut costs = config.costs_by_kind(rigid as u32);
+    // A creature built at the hybrid level switches to it in no frame. Priced as in play, a
+    // crowd of 3,000 came up to it a few hundred a frame, with no room for a rigid creature
+    // meanwhile. (The rigid level's building stays priced at the start, as it always was: a
+    // few creatures' worth, it keeps the runs of the budget experiment as they were.)
+    if starting {
+        costs.iter_mut().for_each(|c| c.cheap_switch_us = 0.0);
+    }
     let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
         let lowest = kinds[c.kind].levels[0];
@@ -1786,7 +1795,7 @@ fn scene<'a>(
 impl DecisionInputs<'_, '_> {
     /// The allocation for every creature now, in the query's order: within `budget_us` as the
     /// cost model predicts it.
-    fn decide(&self, creatures: &Creatures, budget_us: f32) -> Allocation<f32> {
+    fn decide(&self, creatures: &Creatures, budget_us: f32, starting: bool) -> Allocation<f32> {
         let scene = scene(
             &self.config,
             &self.kinds,
@@ -1803,6 +1812,7 @@ impl DecisionInputs<'_, '_> {
             &scene,
             creatures,
             budget_us,
+            starting,
         )
     }
 }
@@ -1816,7 +1826,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     if rules.adaptive_frames > 0.0 {
         tally.correct(rules);
     }
-    let decision = inputs.decide(&creatures, tally.model_budget_us(rules.frame_budget_ms));
+    let decision = inputs.decide(&creatures, tally.model_budget_us(rules.frame_budget_ms), false);
     tally.record(&decision);
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
@@ -1832,7 +1842,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
 pub fn choice_now(world: &mut World) -> Option<Allocation<f32>> {
     let mut state = bevy::ecs::system::SystemState::<(DecisionInputs, Creatures)>::new(world);
     let (inputs, creatures) = state.get_mut(world).ok()?;
-    Some(inputs.decide(&creatures, inputs.config.rules.budget.frame_budget_ms * 1e3))
+    Some(inputs.decide(&creatures, inputs.config.rules.budget.frame_budget_ms * 1e3, false))
 }
 
 /// A new world under the budget policy: its creatures, placed at the cheapest level, start at
@@ -1852,6 +1862,7 @@ fn start_by_budget(
     let decision = inputs.decide(
         &creatures,
         tally.model_budget_us(inputs.config.rules.budget.frame_budget_ms),
+        true,
     );
     let mut searched = decision.settled.iter().peekable();
     for (row, ((entity, c, &lod, _, mut choice), &level)) in creatures.iter_mut().zip(&decision.levels).enumerate() {
