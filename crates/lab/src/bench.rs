@@ -574,7 +574,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
                 &alone,
                 cheap_count,
                 warmup,
-                if how == Calibration::Full { 5 } else { 3 },
+                if how == Calibration::Full { 3 } else { 1 },
             )
         } else {
             0.0
@@ -972,8 +972,9 @@ const SWITCH_PAIRS: usize = 5;
 /// What a switch between the cheap levels costs, us: `count` point masses of `config`'s mix
 /// sent to the hybrid level at once (those out of view need not wait for their flight window),
 /// the frame they switch in over the median of the three before, shared among its switches. The
-/// median of `bursts`, each after a hop's frames at the point mass (those still hybrid then do
-/// not switch in the next burst, nor count).
+/// median of `bursts`, each after the first a hop's frames at the point mass (those still
+/// hybrid then do not switch in the next burst, nor count). Each of a calibration's passes
+/// times its own: at start-up one burst, about 15 ms a kind.
 fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize, bursts: usize) -> f64 {
     let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
     let policy = |sim: &mut HeadlessSim, policy| {
@@ -984,7 +985,14 @@ fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize, bursts: usize)
         sim.advance_frame();
     }
     let mut per_switch = Vec::new();
-    for _ in 0..bursts {
+    for burst in 0..bursts {
+        // Hybrids wait for their window to go down.
+        if burst > 0 {
+            policy(&mut sim, LevelPolicy::AllPointMass);
+            for _ in 0..BACK_DOWN_FRAMES {
+                sim.advance_frame();
+            }
+        }
         let before_s = median((0..3).map(|_| timed_frame(&mut sim)).collect());
         let (switched, start) = (switches(&sim), Instant::now());
         policy(&mut sim, LevelPolicy::AllHybrid);
@@ -993,11 +1001,6 @@ fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize, bursts: usize)
         let n = switches(&sim) - switched;
         if n > 0 {
             per_switch.push((burst_s - before_s) * 1e6 / n as f64);
-        }
-        // Hybrids wait for their window to go down.
-        policy(&mut sim, LevelPolicy::AllPointMass);
-        for _ in 0..BACK_DOWN_FRAMES {
-            sim.advance_frame();
         }
     }
     if per_switch.is_empty() {
