@@ -1529,13 +1529,16 @@ fn decide(
     if starting {
         costs.iter_mut().for_each(|c| c.cheap_switch_us = 0.0);
     }
+    // Whether a kind keeps each level as its floor, worked out once.
+    let held: Vec<[bool; 3]> = (kinds.0.iter().zip(&costs))
+        .map(|(kind, costs)| Lod::ALL.map(|l| costs.holds(l, kind.levels[0])))
+        .collect();
     let floor = |c: &Creature, lod: Lod, choice: &LevelChoice| {
         let dwelling = choice.switched && now_s - choice.last_switch_s < config.rules.min_dwell_s;
-        let lowest = kinds[c.kind].levels[0];
-        if dwelling || costs[c.kind].holds(lod, lowest) {
+        if dwelling || held[c.kind][lod as usize] {
             lod
         } else {
-            lowest
+            kinds[c.kind].levels[0]
         }
     };
     // Each kind at each floor and level, once.
