@@ -1576,9 +1576,10 @@ fn decide(
     // and the choice costs the pass over them above (a crowd far over its budget), charged as
     // such. A creature at its kind's dearest level goes to its floor; the others keep their
     // levels: a cheap level sent to its floor saves a creature hundredths of a microsecond a
-    // frame, and its switch costs it about ten. A crowd's hybrids sent to their floors at once
-    // (40,000 creatures at 10 ms in the adaptive mode, 2026-11-27) made frames of 181, 51 and
-    // 37 ms, and the correction that followed held the crowd at its floors.
+    // frame, and its switch costs it about four (`cheap_switch_us`). A crowd's hybrids sent to
+    // their floors at once (40,000 creatures at 10 ms in the adaptive mode, 2026-11-27) made
+    // frames of 181, 51 and 37 ms, and the correction that followed held the crowd at its
+    // floors.
     if !floors.any_step_fits(room_us) {
         let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
         let dearest: Vec<Option<Lod>> = kinds.0.iter().map(|k| k.levels.iter().copied().max()).collect();
