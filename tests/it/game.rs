@@ -519,8 +519,10 @@ fn calibrating_at_start_up_measures_every_level_and_the_shares_in_the_crowd_that
     let creatures = config.scenario.creature_count();
     let measured = calibrate(&config, Calibration::AtStartUp { creatures });
     // Every kind of the scenario, a rigid creature far dearer than a hybrid one; the court
-    // and the puck cost something whatever the creatures, and so does the choice; where only
-    // the floors fit, the choice is a pass over the creatures and costs less.
+    // and the puck cost something whatever the creatures, and so does the choice, and its pass
+    // where only the floors fit. (Which of the two is dearer per creature is not asserted: with
+    // the switches between the cheap levels priced, the choice's world in play no longer
+    // churns, and the two came out within their spread, 0.069 and 0.075 us, 2026-11-29.)
     let kinds: Vec<&str> = measured.kinds.iter().map(|k| k.kind.as_str()).collect();
     assert_eq!(kinds, ["hopper", "biped"]);
     for k in &measured.kinds {
@@ -530,11 +532,7 @@ fn calibrating_at_start_up_measures_every_level_and_the_shares_in_the_crowd_that
         measured.fixed_us_per_frame > 0.0 && measured.decision_us_per_creature > 0.0,
         "{measured:?}"
     );
-    assert!(
-        measured.floors_only_us_per_creature > 0.0
-            && measured.floors_only_us_per_creature < measured.decision_us_per_creature,
-        "{measured:?}"
-    );
+    assert!(measured.floors_only_us_per_creature > 0.0, "{measured:?}");
     // The default game is no crowd: the crowd's shares are the file's, for a crowd a new
     // round may bring.
     assert!(config.costs.crowd_shares.is_some() && !config.costs.larger_crowd_shares.is_empty());
