@@ -127,9 +127,10 @@ pub struct BudgetRules {
     #[serde(default)]
     pub emergency_over: f32,
     /// 0 (the default): the adaptive mode keeps the mean frame at the budget. 50 to 100: it
-    /// keeps this percentile of the last `adaptive_frames` frames within it, so that a slow
-    /// frame is as rare as that says, not only the mean right: on a machine whose frames
-    /// vary, the mean then sits under the budget by as much as they vary.
+    /// keeps this percentile of the last frames within it, so that a slow frame is as rare as
+    /// that says, not only the mean right: on a machine whose frames vary, the mean then sits
+    /// under the budget by as much as they vary. The percentile is of as many frames as three
+    /// lie beyond (99: the last 300), or of the last `adaptive_frames` where those are more.
     #[serde(default)]
     pub adaptive_percentile: f32,
 }

@@ -30,7 +30,8 @@ pub struct BudgetScaleSettings {
     /// The frame budgets, ms of simulation per 1/30 s.
     pub budgets_ms: Vec<f32>,
     /// The adaptive mode's settings: 0 is the cost model alone; above, the frames over which
-    /// the correction by measured frames is smoothed (and the percentile taken).
+    /// the correction by measured frames is smoothed (and at least those the percentile is
+    /// taken of).
     pub adaptive_frames: Vec<f32>,
     /// What each adaptive setting above 0 keeps at the budget, each a game: 0 the mean frame,
     /// 50 to 100 that percentile of the frames (a file without it: the mean only).
