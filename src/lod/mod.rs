@@ -13,7 +13,10 @@ pub use crate::config::LevelPolicy;
 pub use crate::contract::{AtHybrid, AtPointMass, AtRigid, Lod};
 use crate::kind::Creature;
 pub use blend::{Drawn, DrawnBefore, Pop, PopSummary, PopTally, Spread, SwitchBlend, SwitchProbe, drawn};
-pub use budget::{Allocation, BudgetSummary, BudgetTally, Candidate, RecentFrames, allocate, choice_now, nearest_rank};
+pub use budget::{
+    Allocation, BudgetSummary, BudgetTally, Candidate, RecentFrames, allocate, choice_now, nearest_rank,
+    percentile_window,
+};
 pub use select::{CameraFromView, InfluenceArea, LevelChoice, LevelsSettled, SimCamera, ViewReach, in_influence};
 pub use switch::{LevelSwitched, SwitchTally};
 

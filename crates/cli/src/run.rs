@@ -226,7 +226,10 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
         let adaptive = if b.adaptive {
             let keeps = match b.adaptive_percentile {
                 0.0 => String::new(),
-                p => format!(" keeping the {p}th percentile of the frames within the budget"),
+                p => format!(
+                    " keeping the {p}th percentile of the last {} frames within the budget",
+                    simlod::lod::percentile_window(config.rules.budget.adaptive_frames, p)
+                ),
             };
             format!(
                 " (adaptive{keeps}, not reproducible: the cost model corrected x {:.2} at the end)",

@@ -175,7 +175,10 @@ impl Game {
         match (self.adaptive_frames, self.adaptive_percentile) {
             (0.0, _) => "off".into(),
             (frames, 0.0) => format!("{frames} frames"),
-            (frames, p) => format!("{frames} frames, {p}th percentile"),
+            (frames, p) => format!(
+                "{frames} frames, {p}th percentile of {}",
+                simlod::lod::percentile_window(frames, p)
+            ),
         }
     }
 
