@@ -1048,9 +1048,8 @@ impl RecentFrames {
 const FRAMES_BEYOND_THE_PERCENTILE: f32 = 3.0;
 
 /// How many of the last frames the percentile mode takes its `percentile` (50 to 100) of: at
-/// least `adaptive_frames`, and enough that [`FRAMES_BEYOND_THE_PERCENTILE`] lie beyond it (99:
-/// the last 300, 10 s of decisions at 30 a second; 100: the slowest of `adaptive_frames`), at
-/// most 10,000.
+/// least `adaptive_frames`, and enough that three lie beyond it (99: the last 300, 10 s of
+/// decisions at 30 a second; 100: the slowest of `adaptive_frames`), at most 10,000.
 pub fn percentile_window(adaptive_frames: f32, percentile: f32) -> usize {
     let beyond = if percentile < 100.0 {
         (FRAMES_BEYOND_THE_PERCENTILE * 100.0 / (100.0 - percentile)).ceil()
