@@ -46,8 +46,9 @@ pub struct FrameBudgetInGame {
     /// corrects the cost model by its measured frames, smoothed over this many; 0 leaves it
     /// off. 0 to 10,000 frames.
     pub adaptive_frames: f32,
-    /// With it, the percentile of those frames the game keeps within the budget (see the
-    /// rules' `budget.adaptive_percentile`); 0, as a file without it, their mean.
+    /// With it, the percentile of the last frames the game keeps within the budget (see the
+    /// rules' `budget.adaptive_percentile`, which says how many); 0, as a file without it,
+    /// their mean.
     #[serde(default)]
     pub adaptive_percentile: f32,
     /// Whether the game measures the cost model on the machine that plays before its window
