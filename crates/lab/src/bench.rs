@@ -56,10 +56,15 @@ pub fn median_frame_seconds(config: SimConfig, warmup: usize, frames: usize) -> 
 
 /// Median frame time in seconds of a world already built, after a warm-up.
 pub fn median_frame_seconds_of(sim: &mut HeadlessSim, warmup: usize, frames: usize) -> f64 {
-    for _ in 0..warmup {
+    play_on(sim, warmup);
+    median((0..frames).map(|_| timed_frame(sim)).collect())
+}
+
+/// `frames` frames of `sim`, untimed.
+fn play_on(sim: &mut HeadlessSim, frames: usize) {
+    for _ in 0..frames {
         sim.advance_frame();
     }
-    median((0..frames).map(|_| timed_frame(sim)).collect())
 }
 
 /// One frame of `sim`, in seconds of wall time.
@@ -69,21 +74,26 @@ fn timed_frame(sim: &mut HeadlessSim) -> f64 {
     start.elapsed().as_secs_f64()
 }
 
-/// How much longer a frame of `config` takes than a frame of `base` run beside it, the two
-/// worlds stepped a frame each in turn: the median, in seconds. This machine runs fast and
-/// slow by spells of a fraction of a second, longer than a frame: a frame and its neighbour
-/// share the spell, so it cancels, where two figures taken apart differ by it.
-fn median_extra_seconds(config: &SimConfig, base: &SimConfig, warmup: usize, frames: usize) -> f64 {
-    let (mut sim, mut beside) = (HeadlessSim::new(config.clone()), HeadlessSim::new(base.clone()));
+/// How much longer a frame of `sim` takes than a frame of `beside`, the two worlds stepped a
+/// frame each in turn: the median, in seconds. This machine runs fast and slow by spells of a
+/// fraction of a second, longer than a frame: a frame and its neighbour share the spell, so it
+/// cancels, where two figures taken apart differ by it.
+fn median_extra_seconds(sim: &mut HeadlessSim, beside: &mut HeadlessSim, warmup: usize, frames: usize) -> f64 {
     for _ in 0..warmup {
         sim.advance_frame();
         beside.advance_frame();
     }
-    median(
-        (0..frames)
-            .map(|_| timed_frame(&mut sim) - timed_frame(&mut beside))
-            .collect(),
-    )
+    median((0..frames).map(|_| timed_frame(sim) - timed_frame(beside)).collect())
+}
+
+/// The scenario `sim` plays, as it stands.
+fn played(sim: &HeadlessSim) -> &SimConfig {
+    sim.app.world().resource::<SimConfig>()
+}
+
+/// The scenario `sim` plays, to change as it plays (read at every steering decision).
+fn playing(sim: &mut HeadlessSim) -> bevy::prelude::Mut<'_, SimConfig> {
+    sim.app.world_mut().resource_mut::<SimConfig>()
 }
 
 /// The median over `runs` fresh runs of their median frame times: one run's figure moves
@@ -129,9 +139,7 @@ fn choice_bench(
     let mut game = scaled(config, creatures, LevelPolicy::Budget);
     (game.rules.budget.frame_budget_ms, game.rules.budget.adaptive_frames) = (budget_ms, 0.0);
     let mut sim = HeadlessSim::new(game);
-    for _ in 0..warmup {
-        sim.advance_frame();
-    }
+    play_on(&mut sim, warmup);
     let weight = config.rules.budget.creature_weight;
     [(Some(budget_ms), weight), (None, 0.0)].map(|(frame_budget_ms, creature_weight)| {
         let budget_ms = frame_budget_ms.unwrap_or(f32::MAX);
@@ -421,9 +429,16 @@ const RIGID_COUNTS: [u32; 5] = [10, 40, 160, 400, 800];
 
 /// Microseconds a frame of `count` creatures of `config` all under `policy` takes over a court
 /// without creatures stepped beside it, per creature.
-fn per_creature_us(config: &SimConfig, count: u32, policy: LevelPolicy, (warmup, frames): (usize, usize)) -> f64 {
-    let (world, court) = (scaled(config, count, policy), scaled(config, 0, policy));
-    (median_extra_seconds(&world, &court, warmup, frames) * 1e6).max(0.0) / f64::from(count)
+fn per_creature_us(config: &SimConfig, count: u32, policy: LevelPolicy, effort: (usize, usize)) -> f64 {
+    let mut world = HeadlessSim::new(scaled(config, count, policy));
+    extra_us_per_creature(&mut world, &mut HeadlessSim::new(scaled(config, 0, policy)), effort)
+}
+
+/// Microseconds a frame of `sim` takes over a frame of `beside` (see
+/// [`median_extra_seconds`]), per creature of `sim`.
+fn extra_us_per_creature(sim: &mut HeadlessSim, beside: &mut HeadlessSim, (warmup, frames): (usize, usize)) -> f64 {
+    let count = played(sim).scenario.creature_count();
+    (median_extra_seconds(sim, beside, warmup, frames) * 1e6).max(0.0) / f64::from(count.max(1))
 }
 
 /// The game's start-up: `model`'s shares in the crowd that plays, `creatures` of the scenario's
@@ -435,13 +450,14 @@ fn per_creature_us(config: &SimConfig, count: u32, policy: LevelPolicy, (warmup,
 /// what they ran, and 350 rigid creatures among 4,000 at 0.57 (2026-11-29).
 fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> CostModel {
     let effort = (12, 8);
+    let mut crowd = under_the_budget(config, creatures, &model);
     (model.crowd_shares, model.larger_crowd_shares) = if creatures >= simlod::PARALLEL_MIN_CREATURES {
-        (Some(crowd_shares(config, &model, creatures, effort)), Vec::new())
+        (Some(crowd_shares(config, &model, &mut crowd, effort)), Vec::new())
     } else {
         (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone())
     };
     model.rigid_shares = Vec::new();
-    let [point_mass, hybrid, rigid_us] = mix_us(config, &model, creatures, 0);
+    let [point_mass, hybrid, rigid_us] = mix_us(played(&crowd), &model, 0);
     let rest_us = f64::from(model.overhead_us(creatures as usize)) + f64::from(creatures) * point_mass.max(hybrid);
     let holds = (f64::from(config.rules.budget.frame_budget_ms) * 1e3 - rest_us) / rigid_us.max(1e-9);
     let mut counts: Vec<u32> = RIGID_COUNTS
@@ -460,35 +476,52 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
         .position(|&r| f64::from(r) >= holds)
         .map_or(counts.len(), |i| i + 1);
     let counts = &counts[first..needed.max(first + 1).min(counts.len())];
-    model.rigid_shares = rigid_shares(config, &model, counts, |_| creatures, effort);
+    model.rigid_shares = rigid_shares(config, &model, counts, Some(&mut crowd), effort);
     model
 }
 
 /// The rigid level's shares in play (see [`rigid_in_play`]) with room for each of `counts`
-/// rigid creatures among `among(count)` creatures, by how many were rigid. The file requires
-/// the counts rising: one that came out no more than the one before is left out.
+/// rigid creatures, among the `crowd` given, else in a world of their own of four times as
+/// many creatures of the scenario's mix; by how many were rigid. One that came out under half
+/// its room is left out: a crowd climbs from its floors a few tens of creatures a frame, and
+/// among 2,548 creatures with room for ten rigid ones, one was rigid and its share came out
+/// at 10, the most a share may be (2026-12-01); the model's figure is nearer. The file
+/// requires the counts rising: one that came out no more than the one before is left out too.
 fn rigid_shares(
     config: &SimConfig,
     model: &CostModel,
     counts: &[u32],
-    among: impl Fn(u32) -> u32,
+    mut crowd: Option<&mut HeadlessSim>,
     effort: (usize, usize),
 ) -> Vec<RigidShare> {
     let mut shares: Vec<RigidShare> = Vec::new();
     for &count in counts {
-        let (rigid, share) = rigid_in_play(config, model, among(count), count, effort);
-        if shares.last().is_none_or(|fewer| rigid > fewer.rigid) {
+        let (rigid, share) = match crowd.as_deref_mut() {
+            Some(crowd) => rigid_in_play(crowd, model, count, effort),
+            None => {
+                let mut own = under_the_budget(config, 4 * count, model);
+                rigid_in_play(&mut own, model, count, effort)
+            }
+        };
+        if 2 * rigid >= count && shares.last().is_none_or(|fewer| rigid > fewer.rigid) {
             shares.push(RigidShare { rigid, share });
         }
     }
     shares
 }
 
-/// The cheap levels' and the choice's shares in the scenario's crowd of `count`, stepped across
-/// the cores, of `model`'s figures (measured among [`BELOW_A_CROWD`], on one thread). Each
-/// level's crowd figure is taken right after the one-thread figure it is a share of: taken
-/// apart, a slow spell of the machine under one of them moved the share by a third. The
-/// choice's is of the choice in play at that size (see [`choice_in_play_us`]): what it does
+/// The cheap levels' and the choice's shares in `crowd` (see [`under_the_budget`], not yet
+/// played), stepped across the cores, of `model`'s figures for that mix
+/// (measured among [`BELOW_A_CROWD`], on one thread): so that the model prices the crowd at
+/// what it measured there. Two worlds of the crowd play on through every figure, where one
+/// for each once did (building 100,000 creatures takes 0.15 s, and a world's first frames are
+/// its slowest): one at each cheap level in turn, going up (a crowd's hybrids sent down at
+/// once make its slowest frames), then `crowd` under the budget, from its floors up (where no
+/// step fits, the budget keeps cheap levels as they are). A level's share once
+/// divided the crowd's figure by one taken among 2,000 right before it, to cancel a slow spell
+/// common to both; in four start-ups of 40,000 within minutes that figure ran 0.050 to 0.077
+/// us a point mass where the crowd's ran 0.055 to 0.066 (2026-12-01). The choice's is of the
+/// choice in play at that size (see [`choice_in_play_us`]): what it does
 /// beside the choice itself (writing the levels, the switch stage's passes) is a smaller part
 /// of it there. Taken by the choice alone's share, the model charged 40,000 creatures at 30 ms
 /// about 13 ms too much a frame (2026-11-28). Where only the floors fit, the crowd's frames
@@ -496,16 +529,39 @@ fn rigid_shares(
 /// same crowd under a fixed policy stepped beside it, the frames of 40,000 creatures at their
 /// floors ran 1.1 to 1.5 times their prediction in six runs of an hour (2026-11-29). The rigid
 /// level's share is left at 1.
-fn crowd_shares(config: &SimConfig, model: &CostModel, count: u32, (warmup, frames): (usize, usize)) -> CrowdShares {
+fn crowd_shares(
+    config: &SimConfig,
+    model: &CostModel,
+    crowd: &mut HeadlessSim,
+    (warmup, frames): (usize, usize),
+) -> CrowdShares {
+    let count = played(crowd).scenario.creature_count();
     let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
-    let level_share = |policy| {
-        let alone = per_creature_us(config, BELOW_A_CROWD, policy, (warmup, frames));
-        share(per_creature_us(config, count, policy, (warmup, frames)), alone)
+    let one_thread = CostModel {
+        crowd_shares: None,
+        larger_crowd_shares: Vec::new(),
+        ..model.clone()
     };
-    let (point_mass, hybrid) = (
-        level_share(LevelPolicy::AllPointMass),
-        level_share(LevelPolicy::AllHybrid),
+    let one_thread_us = mix_us(played(crowd), &one_thread, 0);
+    let (mut levels, mut court) = (
+        HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass)),
+        HeadlessSim::new(scaled(config, 0, LevelPolicy::AllPointMass)),
     );
+    let mut level_share = |levels: &mut HeadlessSim, level: Lod| {
+        share(
+            extra_us_per_creature(levels, &mut court, (warmup, frames)),
+            one_thread_us[level as usize],
+        )
+    };
+    let point_mass = level_share(&mut levels, Lod::PointMass);
+    // The choice alone, among point masses: with room for every step, its work is the same
+    // whatever the model's figures.
+    let alone = choice_cost_us(&mut levels, &one_thread, frames.div_ceil(3), false);
+    // The warm-up is the crowd's switch: those out of view at once, the rest in their next
+    // flight window.
+    playing(&mut levels).scenario.level_policy = LevelPolicy::AllHybrid;
+    let hybrid = level_share(&mut levels, Lod::Hybrid);
+    drop(levels);
     let mut shares = CrowdShares {
         creatures: count,
         point_mass,
@@ -520,17 +576,12 @@ fn crowd_shares(config: &SimConfig, model: &CostModel, count: u32, (warmup, fram
         larger_crowd_shares: Vec::new(),
         ..model.clone()
     };
-    let crowd = choice_cost_us(config, &at_count, count, (warmup, frames.div_ceil(3)), false);
-    let floors_us = in_play(config, &at_count, count, 0.0, (warmup, frames)).beyond_the_cheap_us_per_creature(count);
+    let floors_us = in_play(crowd, &at_count, 0.0, (warmup, frames)).beyond_the_cheap_us_per_creature(count);
     shares.floors_only = share(floors_us, f64::from(model.floors_only_us_per_creature));
     at_count.crowd_shares = Some(shares);
-    let in_play = choice_in_play_us(
-        config,
-        &at_count,
-        count,
-        crowd.per_creature_us,
-        (warmup.max(30), frames),
-    );
+    // Long enough for half the crowd to climb to the hybrid level (the switches are priced,
+    // so they come a few hundred a frame).
+    let in_play = choice_in_play_us(crowd, &at_count, alone.per_creature_us, (warmup.max(30), frames));
     shares.choice = share(in_play, f64::from(model.decision_us_per_creature));
     shares
 }
@@ -601,16 +652,14 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         larger_crowd_shares: Vec::new(),
         rigid_shares: Vec::new(),
     };
-    let choice = choice_cost_us(config, &model, cheap_count, (warmup, frames), true);
+    // The choice timed among point masses, then in play in the same world.
+    let mut choosing = HeadlessSim::new(scaled(config, cheap_count, LevelPolicy::AllPointMass));
+    play_on(&mut choosing, warmup);
+    let choice = choice_cost_us(&mut choosing, &model, frames, true);
     model.floors_only_us_per_creature = floors_only_us(config, &model, cheap_count, (warmup, frames)) as f32;
     model.contact_search_us = choice.search_us as f32;
-    model.decision_us_per_creature = choice_in_play_us(
-        config,
-        &model,
-        cheap_count,
-        choice.per_creature_us,
-        (warmup.max(30), frames),
-    ) as f32;
+    model.decision_us_per_creature =
+        choice_in_play_us(&mut choosing, &model, choice.per_creature_us, (warmup.max(30), frames)) as f32;
     if let Calibration::AtStartUp { .. } = how {
         return model;
     }
@@ -620,13 +669,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         Calibration::Quick => &[10, 100],
         _ => &RIGID_COUNTS,
     };
-    model.rigid_shares = rigid_shares(
-        config,
-        &model,
-        rigid_counts,
-        |rigid| 4 * rigid,
-        (warmup.max(30), frames),
-    );
+    model.rigid_shares = rigid_shares(config, &model, rigid_counts, None, (warmup.max(30), frames));
     // The cheap levels and the choice in crowds stepped across the cores (a creature costs less
     // the larger the crowd: at 4,096 a point mass about its cost on one thread, at 65,536 two
     // thirds of it, 2026-11-27).
@@ -634,18 +677,6 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
         Calibration::Quick => &[8 * simlod::PARALLEL_MIN_CREATURES],
         _ => &[2, 8, 32].map(|k| k * simlod::PARALLEL_MIN_CREATURES),
     };
-    let mut measured: Vec<CrowdShares> = (crowds.iter())
-        .map(|&count| crowd_shares(config, &model, count, (warmup, frames)))
-        .collect();
-    let with_shares = |model: &mut CostModel, measured: &[CrowdShares]| {
-        model.crowd_shares = measured.first().copied();
-        model.larger_crowd_shares = measured[1..].to_vec();
-    };
-    // Then the rigid level among each crowd, at its share among as many rigid creatures: among
-    // tens of thousands it cost more than among four times the rigid ones (100,000 creatures at
-    // 30 ms ran 1.21 times the budget without it, 2026-11-27). The cheap levels and the choice
-    // at their shares just measured.
-    with_shares(&mut model, &measured);
     let rigid_among = match how {
         Calibration::Quick => 100,
         _ => 400,
@@ -654,10 +685,22 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     // (the smallest crowd's share measured 0.84 to 1.33 in seven calibrations in an hour,
     // 2026-11-28, where they say 1).
     let largest = 4 * rigid_counts.last().copied().unwrap_or(0);
-    for i in 0..measured.len() {
-        let count = measured[i].creatures;
+    let with_shares = |model: &mut CostModel, measured: &[CrowdShares]| {
+        model.crowd_shares = measured.first().copied();
+        model.larger_crowd_shares = measured[1..].to_vec();
+    };
+    let mut measured: Vec<CrowdShares> = Vec::new();
+    for &count in crowds {
+        let mut crowd = under_the_budget(config, count, &model);
+        measured.push(crowd_shares(config, &model, &mut crowd, (warmup, frames)));
+        with_shares(&mut model, &measured);
+        // Then the rigid level in the same crowd, at its share among as many rigid creatures:
+        // among tens of thousands it cost more than among four times the rigid ones (100,000
+        // creatures at 30 ms ran 1.21 times the budget without it, 2026-11-27). The cheap
+        // levels and the choice at their shares just measured.
         if count > 2 * largest {
-            (_, measured[i].rigid) = rigid_in_play(config, &model, count, rigid_among, (warmup.max(30), frames));
+            let (_, rigid) = rigid_in_play(&mut crowd, &model, rigid_among, (warmup.max(30), frames));
+            measured.last_mut().expect("just measured").rigid = rigid;
             with_shares(&mut model, &measured);
         }
     }
@@ -752,33 +795,24 @@ struct ChoiceCost {
     search_us: f64,
 }
 
-/// The budget policy's own choice, timed on the scenario's crowd of `count` after a warm-up:
-/// with room for every creature's every step (so nothing is left out), without the search
-/// for contacts between creatures (the creatures' weight at 0, so none needs it); and,
-/// `with_searches`, per creature searched (else 0).
-fn choice_cost_us(
-    config: &SimConfig,
-    model: &CostModel,
-    count: u32,
-    (warmup, calls): (usize, usize),
-    with_searches: bool,
-) -> ChoiceCost {
-    let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
-    for _ in 0..warmup {
-        sim.advance_frame();
-    }
-    sim.app.world_mut().resource_mut::<SimConfig>().costs = model.clone();
-    let mut time_choice = |creature_weight, budget_ms| timed_choice(&mut sim, budget_ms, creature_weight, calls);
-    let per_creature = |us: f64| us / f64::from(count.max(1));
+/// The budget policy's own choice, timed in `sim` as it stands: with room for every
+/// creature's every step (so nothing is left out), without the search for contacts between
+/// creatures (the creatures' weight at 0, so none needs it); and, `with_searches`, per creature
+/// searched (else 0). The world's rules are left as they were, to play on.
+fn choice_cost_us(sim: &mut HeadlessSim, model: &CostModel, calls: usize, with_searches: bool) -> ChoiceCost {
+    let (count, rules) = (played(sim).scenario.creature_count(), played(sim).rules.budget.clone());
+    playing(sim).costs = model.clone();
+    let mut time_choice = |creature_weight, budget_ms| timed_choice(sim, budget_ms, creature_weight, calls);
     let (unsearched_us, _) = time_choice(0.0, f32::MAX);
     let search_us = if with_searches {
-        let (searched_us, searched) = time_choice(config.rules.budget.creature_weight, f32::MAX);
+        let (searched_us, searched) = time_choice(rules.creature_weight, f32::MAX);
         (searched_us - unsearched_us).max(0.0) / searched.max(1) as f64
     } else {
         0.0
     };
+    playing(sim).rules.budget = rules;
     ChoiceCost {
-        per_creature_us: per_creature(unsearched_us),
+        per_creature_us: unsearched_us / f64::from(count.max(1)),
         search_us,
     }
 }
@@ -806,34 +840,37 @@ impl InPlay {
     }
 }
 
-/// The scenario's mix of `count` creatures under the budget policy at `room_us` a frame,
-/// priced by `model`, every frame timed after a warm-up, each beside what `model` says of the
-/// levels its creatures ran at (read after the frame) and of its searches.
-fn in_play(
-    config: &SimConfig,
-    model: &CostModel,
-    count: u32,
-    room_us: f64,
-    (warmup, frames): (usize, usize),
-) -> InPlay {
+/// The scenario's mix of `count` creatures under the budget policy, priced by `model`, with no
+/// room yet: built so, for its first update already chooses (priced by a model still to be
+/// measured, every figure 0, it made 40,000 creatures rigid, and their frames took seconds).
+fn under_the_budget(config: &SimConfig, count: u32, model: &CostModel) -> HeadlessSim {
     let mut game = scaled(config, count, LevelPolicy::Budget);
     game.costs = model.clone();
     let budget = &mut game.rules.budget;
+    (budget.frame_budget_ms, budget.adaptive_frames) = (0.0, 0.0);
+    HeadlessSim::new(game)
+}
+
+/// `sim` played on under the budget policy at `room_us` a frame, priced by `model`, every
+/// frame timed after a warm-up (long enough for its creatures to reach their levels), each
+/// beside what `model` says of the levels its creatures ran at (read after the frame) and of
+/// its searches.
+fn in_play(sim: &mut HeadlessSim, model: &CostModel, room_us: f64, (warmup, frames): (usize, usize)) -> InPlay {
+    let mut game = playing(sim);
+    (game.scenario.level_policy, game.costs) = (LevelPolicy::Budget, model.clone());
+    let budget = &mut game.rules.budget;
     (budget.frame_budget_ms, budget.adaptive_frames) = ((room_us / 1e3) as f32, 0.0);
-    let mut sim = HeadlessSim::new(game.clone());
-    for _ in 0..warmup {
-        sim.advance_frame();
-    }
+    play_on(sim, warmup);
     let (mut measured, mut cheap_us, mut rigid_us, mut rigid) = (Vec::with_capacity(frames), 0.0, 0.0, 0u64);
     for _ in 0..frames {
         let searched_before = sim.app.world().resource::<BudgetTally>().searched;
-        measured.push(timed_frame(&mut sim) * 1e6);
+        measured.push(timed_frame(sim) * 1e6);
         let world = sim.app.world_mut();
         let searched = world.resource::<BudgetTally>().searched - searched_before;
         cheap_us += f64::from(model.fixed_us_per_frame) + searched as f64 * f64::from(model.contact_search_us);
         let mut levels = world.query::<(&Creature, &Lod)>();
         let rigid_now = levels.iter(world).filter(|(_, lod)| **lod == Lod::Rigid).count();
-        let costs = game.costs_by_kind(rigid_now as u32);
+        let costs = world.resource::<SimConfig>().costs_by_kind(rigid_now as u32);
         for (c, &lod) in levels.iter(world) {
             let us = f64::from(costs[c.kind].per_frame_us(lod));
             if lod == Lod::Rigid {
@@ -852,12 +889,14 @@ fn in_play(
     }
 }
 
-/// What `model` says a creature of the scenario's mix costs at each level among `count`,
-/// `rigid` of them rigid.
-fn mix_us(config: &SimConfig, model: &CostModel, count: u32, rigid: u32) -> [f64; 3] {
-    let mut game = scaled(config, count, LevelPolicy::Budget);
-    game.costs = model.clone();
+/// What `model` says a creature of `game`'s mix costs at each level, `rigid` of them rigid.
+fn mix_us(game: &SimConfig, model: &CostModel, rigid: u32) -> [f64; 3] {
+    let game = SimConfig {
+        costs: model.clone(),
+        ..game.clone()
+    };
     let costs = game.costs_by_kind(rigid);
+    let count = game.scenario.creature_count();
     Lod::ALL.map(|level| {
         (game.scenario.creatures.iter().zip(&costs))
             .map(|(g, c)| f64::from(g.count) * f64::from(c.per_frame_us(level)))
@@ -866,9 +905,9 @@ fn mix_us(config: &SimConfig, model: &CostModel, count: u32, rigid: u32) -> [f64
     })
 }
 
-/// The choice's cost per creature in play: the scenario's crowd of `count` under the budget
-/// with room for about half of it at the hybrid level and none rigid (the rigid level priced
-/// out of reach, the choice charged at `alone_us`, the choice alone timed among `count`), what
+/// The choice's cost per creature in play: `sim`'s crowd played on under the budget with room
+/// for about half of it at the hybrid level and none rigid (the rigid level priced out of
+/// reach, the choice charged at `alone_us`, the choice alone timed in that crowd), what
 /// its frames take (their median) beyond what `model` says of the rest of them: the fixed
 /// cost, the searches and the cheap levels at their shares in the crowd. Besides the choice
 /// itself (`choice_now`), this is the writing of every creature's level, the switch stage's
@@ -879,7 +918,7 @@ fn mix_us(config: &SimConfig, model: &CostModel, count: u32, rigid: u32) -> [f64
 /// alone in crowds of tens of thousands, and the model priced 40,000 creatures' cheap frame at
 /// 6.8 ms where it ran 12 (2026-11-29): three worlds of a crowd stepped in turn crowd each
 /// other out of the caches, so the two beside were dearer than the model's figures for them.
-fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us: f64, effort: (usize, usize)) -> f64 {
+fn choice_in_play_us(sim: &mut HeadlessSim, model: &CostModel, alone_us: f64, effort: (usize, usize)) -> f64 {
     let mut priced = model.clone();
     for k in &mut priced.kinds {
         k.costs.rigid_us_per_frame = 1e6;
@@ -889,15 +928,16 @@ fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us
     for shares in priced.crowd_shares.iter_mut().chain(&mut priced.larger_crowd_shares) {
         shares.choice = 1.0;
     }
-    let [pm, hybrid, _] = mix_us(config, &priced, count, 0);
+    let count = played(sim).scenario.creature_count();
+    let [pm, hybrid, _] = mix_us(played(sim), &priced, 0);
     let room_us = f64::from(priced.overhead_us(count as usize)) + f64::from(count) * (pm + hybrid) / 2.0;
-    in_play(config, &priced, count, room_us, effort).beyond_the_cheap_us_per_creature(count)
+    in_play(sim, &priced, room_us, effort).beyond_the_cheap_us_per_creature(count)
 }
 
 /// The rigid level's cost in play as a share of what `model` says of it (among four times as
 /// many creatures as rigid ones, before any rigid share: its kinds' figures, which are measured
-/// in open court, among a few tens of one kind): the scenario's mix of `count` creatures under
-/// the budget policy with room for about `rigid` rigid ones, those it picks (about to touch
+/// in open court, among a few tens of one kind): `sim`'s crowd played on under the budget
+/// policy with room for about `rigid` rigid ones, those it picks (about to touch
 /// something, or in view). The share is what its frames take (their median) beyond the rest of
 /// what the model predicts of them (the fixed cost, the choice and its searches, the cheaper
 /// levels), over what it predicts of the rigid creatures; with how many there were. Rapier
@@ -906,11 +946,12 @@ fn choice_in_play_us(config: &SimConfig, model: &CostModel, count: u32, alone_us
 /// rapier's own work per body grows again (4,000 all rigid: 72 us a hopper or biped in its
 /// stage against 47 among 443); and one about to touch something costs the solver more than
 /// one in open court.
-fn rigid_in_play(config: &SimConfig, model: &CostModel, count: u32, rigid: u32, effort: (usize, usize)) -> (u32, f32) {
-    let [pm, hybrid, rigid_us] = mix_us(config, model, count, rigid);
+fn rigid_in_play(sim: &mut HeadlessSim, model: &CostModel, rigid: u32, effort: (usize, usize)) -> (u32, f32) {
+    let count = played(sim).scenario.creature_count();
+    let [pm, hybrid, rigid_us] = mix_us(played(sim), model, rigid);
     let room_us =
         f64::from(model.overhead_us(count as usize)) + f64::from(count) * hybrid.max(pm) + f64::from(rigid) * rigid_us;
-    let game = in_play(config, model, count, room_us, effort);
+    let game = in_play(sim, model, room_us, effort);
     let choice_us = f64::from(model.overhead_us(count as usize) - model.fixed_us_per_frame);
     (
         game.rigid.round().max(1.0) as u32,
@@ -927,13 +968,9 @@ fn rigid_in_play(config: &SimConfig, model: &CostModel, count: u32, rigid: u32, 
 /// the frames of such a crowd ran 1.2 times their prediction, 1.1 times now. Below a crowd its
 /// charge is a tenth of a millisecond, within the spread of what the model says of the rest of
 /// the frame: taken beyond that, it came out at nothing (2026-11-29).
-fn floors_only_us(config: &SimConfig, model: &CostModel, count: u32, (warmup, frames): (usize, usize)) -> f64 {
-    let mut choosing = scaled(config, count, LevelPolicy::Budget);
-    let budget = &mut choosing.rules.budget;
-    (budget.frame_budget_ms, budget.adaptive_frames) = (0.0, 0.0);
-    choosing.costs = model.clone();
-    let fixed = scaled(config, count, LevelPolicy::AllPointMass);
-    (median_extra_seconds(&choosing, &fixed, warmup, frames) * 1e6).max(0.0) / f64::from(count.max(1))
+fn floors_only_us(config: &SimConfig, model: &CostModel, count: u32, effort: (usize, usize)) -> f64 {
+    let mut fixed = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
+    extra_us_per_creature(&mut under_the_budget(config, count, model), &mut fixed, effort)
 }
 
 /// Microseconds per switch into the rigid level (building a creature's bodies): a world of
@@ -977,21 +1014,15 @@ const SWITCH_PAIRS: usize = 5;
 /// times its own: at start-up one burst, about 15 ms a kind.
 fn cheap_switch_us(config: &SimConfig, count: u32, warmup: usize, bursts: usize) -> f64 {
     let mut sim = HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass));
-    let policy = |sim: &mut HeadlessSim, policy| {
-        sim.app.world_mut().resource_mut::<SimConfig>().scenario.level_policy = policy;
-    };
+    let policy = |sim: &mut HeadlessSim, policy| playing(sim).scenario.level_policy = policy;
     let switches = |sim: &HeadlessSim| sim.app.world().resource::<SwitchTally>().switches.total();
-    for _ in 0..warmup {
-        sim.advance_frame();
-    }
+    play_on(&mut sim, warmup);
     let mut per_switch = Vec::new();
     for burst in 0..bursts {
         // Hybrids wait for their window to go down.
         if burst > 0 {
             policy(&mut sim, LevelPolicy::AllPointMass);
-            for _ in 0..BACK_DOWN_FRAMES {
-                sim.advance_frame();
-            }
+            play_on(&mut sim, BACK_DOWN_FRAMES);
         }
         let before_s = median((0..3).map(|_| timed_frame(&mut sim)).collect());
         let (switched, start) = (switches(&sim), Instant::now());
