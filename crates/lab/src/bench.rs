@@ -511,16 +511,18 @@ fn rigid_shares(
 }
 
 /// The cheap levels' and the choice's shares in `crowd` (see [`under_the_budget`], not yet
-/// played), stepped across the cores, of `model`'s figures for that mix
-/// (measured among [`BELOW_A_CROWD`], on one thread): so that the model prices the crowd at
-/// what it measured there. Two worlds of the crowd play on through every figure, where one
+/// played), stepped across the cores, of `model`'s figures (measured among [`BELOW_A_CROWD`],
+/// on one thread). Two worlds of the crowd play on through every figure, where one
 /// for each once did (building 100,000 creatures takes 0.15 s, and a world's first frames are
 /// its slowest): one at each cheap level in turn, going up (a crowd's hybrids sent down at
 /// once make its slowest frames), then `crowd` under the budget, from its floors up (where no
-/// step fits, the budget keeps cheap levels as they are). A level's share once
-/// divided the crowd's figure by one taken among 2,000 right before it, to cancel a slow spell
-/// common to both; in four start-ups of 40,000 within minutes that figure ran 0.050 to 0.077
-/// us a point mass where the crowd's ran 0.055 to 0.066 (2026-12-01). The choice's is of the
+/// step fits, the budget keeps cheap levels as they are). Each level's crowd figure is taken
+/// right after the one-thread figure it is a share of: taken apart, a slow spell of the
+/// machine under one of them moved the share by a third. That one-thread figure is the
+/// noisier (0.050 to 0.077 us a point mass in four start-ups of 40,000 within minutes, where
+/// the crowd's ran 0.055 to 0.066), yet shares of the model's own figures in its place priced
+/// crowds at their floors 1.18 to 1.38 times under what they ran, in four games of six, where
+/// these were within 10 % in five of eight (2026-12-01). The choice's is of the
 /// choice in play at that size (see [`choice_in_play_us`]): what it does
 /// beside the choice itself (writing the levels, the switch stage's passes) is a smaller part
 /// of it there. Taken by the choice alone's share, the model charged 40,000 creatures at 30 ms
@@ -537,30 +539,22 @@ fn crowd_shares(
 ) -> CrowdShares {
     let count = played(crowd).scenario.creature_count();
     let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
-    let one_thread = CostModel {
-        crowd_shares: None,
-        larger_crowd_shares: Vec::new(),
-        ..model.clone()
-    };
-    let one_thread_us = mix_us(played(crowd), &one_thread, 0);
     let (mut levels, mut court) = (
         HeadlessSim::new(scaled(config, count, LevelPolicy::AllPointMass)),
         HeadlessSim::new(scaled(config, 0, LevelPolicy::AllPointMass)),
     );
-    let mut level_share = |levels: &mut HeadlessSim, level: Lod| {
-        share(
-            extra_us_per_creature(levels, &mut court, (warmup, frames)),
-            one_thread_us[level as usize],
-        )
+    let mut level_share = |levels: &mut HeadlessSim, policy| {
+        let alone = per_creature_us(config, BELOW_A_CROWD, policy, (warmup, frames));
+        share(extra_us_per_creature(levels, &mut court, (warmup, frames)), alone)
     };
-    let point_mass = level_share(&mut levels, Lod::PointMass);
+    let point_mass = level_share(&mut levels, LevelPolicy::AllPointMass);
     // The choice alone, among point masses: with room for every step, its work is the same
     // whatever the model's figures.
-    let alone = choice_cost_us(&mut levels, &one_thread, frames.div_ceil(3), false);
+    let alone = choice_cost_us(&mut levels, model, frames.div_ceil(3), false);
     // The warm-up is the crowd's switch: those out of view at once, the rest in their next
     // flight window.
     playing(&mut levels).scenario.level_policy = LevelPolicy::AllHybrid;
-    let hybrid = level_share(&mut levels, Lod::Hybrid);
+    let hybrid = level_share(&mut levels, LevelPolicy::AllHybrid);
     drop(levels);
     let mut shares = CrowdShares {
         creatures: count,
