@@ -521,9 +521,9 @@ fn rigid_shares(
 /// machine under one of them moved the share by a third. That one-thread figure is the
 /// noisier (0.050 to 0.077 us a point mass in four start-ups of 40,000 within minutes, where
 /// the crowd's ran 0.055 to 0.066), yet shares of the model's own figures in its place priced
-/// crowds at their floors 1.18 to 1.38 times under what they ran, in four games of six, where
-/// these were within 10 % in five of eight (2026-12-01). The choice's is of the
-/// choice in play at that size (see [`choice_in_play_us`]): what it does
+/// crowds at their floors 1.18 to 1.38 times under what they ran in 7 of 11 games, where these
+/// were within 10 % in 8 of 10 the same hour (2026-12-01). The choice's is of the choice in
+/// play at that size (see [`choice_in_play_us`]): what it does
 /// beside the choice itself (writing the levels, the switch stage's passes) is a smaller part
 /// of it there. Taken by the choice alone's share, the model charged 40,000 creatures at 30 ms
 /// about 13 ms too much a frame (2026-11-28). Where only the floors fit, the crowd's frames
