@@ -268,7 +268,7 @@ impl CostModel {
 
     /// The cheap levels' and the choice's shares in a world of `creatures` (see
     /// `larger_crowd_shares`): none short of a crowd.
-    fn shares_in_crowd(&self, creatures: u32) -> Option<CrowdShares> {
+    pub fn shares_in_crowd(&self, creatures: u32) -> Option<CrowdShares> {
         let first = self.crowd_shares.filter(|_| creatures >= PARALLEL_MIN_CREATURES)?;
         let measured = std::iter::once(&first).chain(&self.larger_crowd_shares);
         let (mut below, n) = (first, creatures as f32);

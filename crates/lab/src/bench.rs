@@ -445,17 +445,28 @@ fn extra_us_per_creature(sim: &mut HeadlessSim, beside: &mut HeadlessSim, (warmu
 /// mix. Where it is a crowd, the cheap levels' and the choice's (see [`crowd_shares`]); else the
 /// file's, for a crowd a new round may bring. Then the rigid level's in play in that crowd (see
 /// [`rigid_in_play`]) at each count of [`RIGID_COUNTS`] up to the first the rules' budget
-/// holds, from the first whose rigid creatures are a fair part of the frame. Kept from a file
+/// holds, from the first whose rigid creatures are a fair part of the frame; none, the file's
+/// kept, where the crowd's floors are over that budget. Kept from a file
 /// measured on another machine, these shares priced 100,000 point masses at three quarters of
 /// what they ran, and 350 rigid creatures among 4,000 at 0.57 (2026-11-29).
 fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> CostModel {
     let effort = (12, 8);
     let mut crowd = under_the_budget(config, creatures, &model);
-    (model.crowd_shares, model.larger_crowd_shares) = if creatures >= simlod::PARALLEL_MIN_CREATURES {
-        (Some(crowd_shares(config, &model, &mut crowd, effort)), Vec::new())
+    let budget_ms = config.rules.budget.frame_budget_ms;
+    let beyond_the_floors = if creatures >= simlod::PARALLEL_MIN_CREATURES {
+        let (shares, beyond) = crowd_shares(config, &model, &mut crowd, Some(budget_ms), effort);
+        (model.crowd_shares, model.larger_crowd_shares) = (Some(shares), Vec::new());
+        beyond
     } else {
-        (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone())
+        (model.crowd_shares, model.larger_crowd_shares) =
+            (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone());
+        affords_more_than_the_floors(&mut crowd, &model, budget_ms)
     };
+    if !beyond_the_floors {
+        // No creature of such a crowd is rigid at that budget: the file's rigid shares stand.
+        model.rigid_shares = config.costs.rigid_shares.clone();
+        return model;
+    }
     model.rigid_shares = Vec::new();
     let [point_mass, hybrid, rigid_us] = mix_us(played(&crowd), &model, 0);
     let rest_us = f64::from(model.overhead_us(creatures as usize)) + f64::from(creatures) * point_mass.max(hybrid);
@@ -530,13 +541,16 @@ fn rigid_shares(
 /// beyond what the model says of the rest of them, as the choice in play: timed against the
 /// same crowd under a fixed policy stepped beside it, the frames of 40,000 creatures at their
 /// floors ran 1.1 to 1.5 times their prediction in six runs of an hour (2026-11-29). The rigid
-/// level's share is left at 1.
+/// level's share is left at 1. The floors are measured first: where they are over `budget_ms`
+/// (the budget the crowd plays at, see [`affords_more_than_the_floors`]; false beside the
+/// shares), the hybrid's and the choice's shares are the file's.
 fn crowd_shares(
     config: &SimConfig,
     model: &CostModel,
     crowd: &mut HeadlessSim,
+    budget_ms: Option<f32>,
     (warmup, frames): (usize, usize),
-) -> CrowdShares {
+) -> (CrowdShares, bool) {
     let count = played(crowd).scenario.creature_count();
     let share = |crowd: f64, alone: f64| (crowd / alone.max(1e-9)).clamp(0.01, 10.0) as f32;
     let (mut levels, mut court) = (
@@ -551,16 +565,13 @@ fn crowd_shares(
     // The choice alone, among point masses: with room for every step, its work is the same
     // whatever the model's figures.
     let alone = choice_cost_us(&mut levels, model, frames.div_ceil(3), false);
-    // The warm-up is the crowd's switch: those out of view at once, the rest in their next
-    // flight window.
-    playing(&mut levels).scenario.level_policy = LevelPolicy::AllHybrid;
-    let hybrid = level_share(&mut levels, LevelPolicy::AllHybrid);
-    drop(levels);
+    // Until measured, the file's (1 where it has none).
+    let file = config.costs.shares_in_crowd(count);
     let mut shares = CrowdShares {
         creatures: count,
         point_mass,
-        hybrid,
-        choice: 1.0,
+        hybrid: file.map_or(1.0, |s| s.hybrid),
+        choice: file.map_or(1.0, |s| s.choice),
         floors_only: 1.0,
         rigid: 1.0,
     };
@@ -573,11 +584,31 @@ fn crowd_shares(
     let floors_us = in_play(crowd, &at_count, 0.0, (warmup, frames)).beyond_the_cheap_us_per_creature(count);
     shares.floors_only = share(floors_us, f64::from(model.floors_only_us_per_creature));
     at_count.crowd_shares = Some(shares);
+    // A crowd whose floors are over the rules' budget plays at its floors: the rest of its
+    // figures would price levels it never reaches (at the shipped 4 ms, from about 40,000
+    // creatures; 100,000 took 7 s to measure them all, 2026-12-02).
+    if budget_ms.is_some_and(|budget_ms| !affords_more_than_the_floors(crowd, &at_count, budget_ms)) {
+        return (shares, false);
+    }
+    // The warm-up is the crowd's switch: those out of view at once, the rest in their next
+    // flight window.
+    playing(&mut levels).scenario.level_policy = LevelPolicy::AllHybrid;
+    shares.hybrid = level_share(&mut levels, LevelPolicy::AllHybrid);
+    drop(levels);
+    at_count.crowd_shares = Some(shares);
     // Long enough for half the crowd to climb to the hybrid level (the switches are priced,
     // so they come a few hundred a frame).
     let in_play = choice_in_play_us(crowd, &at_count, alone.per_creature_us, (warmup.max(30), frames));
     shares.choice = share(in_play, f64::from(model.decision_us_per_creature));
-    shares
+    (shares, true)
+}
+
+/// Whether `sim`'s crowd as it stands, priced by `model`, costs less at its floors than
+/// `budget_ms` (the budget policy's choice, not applied): if not, it plays at its floors.
+fn affords_more_than_the_floors(sim: &mut HeadlessSim, model: &CostModel, budget_ms: f32) -> bool {
+    let mut game = playing(sim);
+    (game.costs, game.rules.budget.frame_budget_ms) = (model.clone(), budget_ms);
+    simlod::lod::choice_now(sim.app.world_mut()).is_some_and(|a| !a.exceeded)
 }
 
 /// One pass of [`calibrate`]: every figure measured once.
@@ -686,7 +717,7 @@ fn calibrate_pass(config: &SimConfig, how: Calibration) -> CostModel {
     let mut measured: Vec<CrowdShares> = Vec::new();
     for &count in crowds {
         let mut crowd = under_the_budget(config, count, &model);
-        measured.push(crowd_shares(config, &model, &mut crowd, (warmup, frames)));
+        measured.push(crowd_shares(config, &model, &mut crowd, None, (warmup, frames)).0);
         with_shares(&mut model, &measured);
         // Then the rigid level in the same crowd, at its share among as many rigid creatures:
         // among tens of thousands it cost more than among four times the rigid ones (100,000
