@@ -577,13 +577,17 @@ fn calibrating_at_start_up_for_a_crowd_measures_its_shares_at_that_crowd() {
 
 #[test]
 fn calibrating_at_start_up_a_crowd_whose_floors_are_over_the_budget_measures_them_and_keeps_the_files_other_shares() {
-    use simlod_lab::bench::{Calibration, calibrate};
     let mut config = SimConfig::load(Path::new("assets/scenarios/default.ron"), Path::new("assets")).unwrap();
     // Not even the court and the puck fit, on any machine: the crowd plays at its floors.
     config.rules.budget.frame_budget_ms = 0.1;
     let creatures = simlod::PARALLEL_MIN_CREATURES + 500;
+    let config = simlod_lab::scene::scaled(&config, creatures, LevelPolicy::Budget);
     let file = config.costs.shares_in_crowd(creatures).unwrap();
-    let measured = calibrate(&config, Calibration::AtStartUp { creatures });
+    let (measured, said) = simlod_lab::bench::calibrate_at_start_up(&config);
+    assert!(
+        said.contains("its floors over the 0.1 ms budget, where it plays") && said.contains("not measured"),
+        "{said}"
+    );
     let shares = measured.crowd_shares.unwrap_or_else(|| panic!("{measured:?}"));
     assert_eq!(shares.creatures, creatures);
     // The point mass measured in the crowd; the levels above it, the choice among them and

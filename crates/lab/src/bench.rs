@@ -386,35 +386,36 @@ pub enum Calibration {
 /// per creature in a crowd stepped across the cores, as shares of their cost on one thread
 /// (both, at start-up, in the crowd that plays: see `in_the_crowd_that_plays`).
 pub fn calibrate(config: &SimConfig, how: Calibration) -> CostModel {
-    // Whole passes over every figure, each figure the median of the passes': a pass takes a
-    // few seconds, and this machine has slow spells as long (rigid creatures and the fixed
-    // cost measured a third dearer throughout one calibration, and not in the next).
+    match how {
+        Calibration::AtStartUp { creatures } => in_the_crowd_that_plays(config, passes(config, how), creatures).0,
+        Calibration::Full | Calibration::Quick => passes(config, how),
+    }
+}
+
+/// Whole passes over every figure, each figure the median of the passes': a pass takes a few
+/// seconds, and this machine has slow spells as long (rigid creatures and the fixed cost
+/// measured a third dearer throughout one calibration, and not in the next).
+fn passes(config: &SimConfig, how: Calibration) -> CostModel {
     let passes = match how {
         Calibration::Full | Calibration::AtStartUp { .. } => 3,
         Calibration::Quick => 1,
     };
-    let model = median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>());
-    match how {
-        Calibration::AtStartUp { creatures } => in_the_crowd_that_plays(config, model, creatures),
-        Calibration::Full | Calibration::Quick => model,
-    }
+    median_model(&(0..passes).map(|_| calibrate_pass(config, how)).collect::<Vec<_>>())
 }
 
 /// The cost model measured as the game measures it at start-up, in the crowd of `config`'s
-/// scenario, and what it says: how long it took and its lines, for a log or a terminal.
+/// scenario, and what it says: how long it took, its lines and what of it is the file's, for a
+/// log or a terminal.
 pub fn calibrate_at_start_up(config: &SimConfig) -> (CostModel, String) {
     let start = Instant::now();
-    let model = calibrate(
-        config,
-        Calibration::AtStartUp {
-            creatures: config.scenario.creature_count(),
-        },
-    );
+    let creatures = config.scenario.creature_count();
+    let how = Calibration::AtStartUp { creatures };
+    let (model, kept) = in_the_crowd_that_plays(config, passes(config, how), creatures);
     let mut said = format!(
         "measured in {:.1} s (us per creature per 1/30 s):",
         start.elapsed().as_secs_f32()
     );
-    for line in cost_model_lines(&model) {
+    for line in cost_model_lines(&model).iter().chain(&kept) {
         said += &format!("\n  {line}");
     }
     (model, said)
@@ -449,7 +450,7 @@ fn extra_us_per_creature(sim: &mut HeadlessSim, beside: &mut HeadlessSim, (warmu
 /// kept, where the crowd's floors are over that budget. Kept from a file
 /// measured on another machine, these shares priced 100,000 point masses at three quarters of
 /// what they ran, and 350 rigid creatures among 4,000 at 0.57 (2026-11-29).
-fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> CostModel {
+fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: u32) -> (CostModel, Option<String>) {
     let effort = (12, 8);
     let mut crowd = under_the_budget(config, creatures, &model);
     let budget_ms = config.rules.budget.frame_budget_ms;
@@ -462,10 +463,17 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
             (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone());
         affords_more_than_the_floors(&mut crowd, &model, budget_ms)
     };
+    let from_file = "from the file (1 and none without one), not measured";
     if !beyond_the_floors {
         // No creature of such a crowd is rigid at that budget: the file's rigid shares stand.
         model.rigid_shares = config.costs.rigid_shares.clone();
-        return model;
+        let what = if creatures >= simlod::PARALLEL_MIN_CREATURES {
+            "the hybrid's and the choice's crowd shares and the rigid level's shares"
+        } else {
+            "the crowd shares and the rigid level's shares"
+        };
+        let kept = format!("its floors over the {budget_ms} ms budget, where it plays: {what} {from_file}");
+        return (model, Some(kept));
     }
     model.rigid_shares = Vec::new();
     let [point_mass, hybrid, rigid_us] = mix_us(played(&crowd), &model, 0);
@@ -488,7 +496,9 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
         .map_or(counts.len(), |i| i + 1);
     let counts = &counts[first..needed.max(first + 1).min(counts.len())];
     model.rigid_shares = rigid_shares(config, &model, counts, Some(&mut crowd), effort);
-    model
+    let kept = (creatures < simlod::PARALLEL_MIN_CREATURES)
+        .then(|| "no crowd: the crowd shares, for a crowd a new round may bring, from the file, not measured".into());
+    (model, kept)
 }
 
 /// The rigid level's shares in play (see [`rigid_in_play`]) with room for each of `counts`
