@@ -454,7 +454,8 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
     let effort = (12, 8);
     let mut crowd = under_the_budget(config, creatures, &model);
     let budget_ms = config.rules.budget.frame_budget_ms;
-    let beyond_the_floors = if creatures >= simlod::PARALLEL_MIN_CREATURES {
+    let in_a_crowd = creatures >= simlod::PARALLEL_MIN_CREATURES;
+    let beyond_the_floors = if in_a_crowd {
         let (shares, beyond) = crowd_shares(config, &model, &mut crowd, Some(budget_ms), effort);
         (model.crowd_shares, model.larger_crowd_shares) = (Some(shares), Vec::new());
         beyond
@@ -463,16 +464,17 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
             (config.costs.crowd_shares, config.costs.larger_crowd_shares.clone());
         affords_more_than_the_floors(&mut crowd, &model, budget_ms)
     };
-    let from_file = "from the file (1 and none without one), not measured";
     if !beyond_the_floors {
         // No creature of such a crowd is rigid at that budget: the file's rigid shares stand.
         model.rigid_shares = config.costs.rigid_shares.clone();
-        let what = if creatures >= simlod::PARALLEL_MIN_CREATURES {
+        let what = if in_a_crowd {
             "the hybrid's and the choice's crowd shares and the rigid level's shares"
         } else {
             "the crowd shares and the rigid level's shares"
         };
-        let kept = format!("its floors over the {budget_ms} ms budget, where it plays: {what} {from_file}");
+        let kept = format!(
+            "its floors over the {budget_ms} ms budget, where it plays: {what} from the file (1 and none without one), not measured"
+        );
         return (model, Some(kept));
     }
     model.rigid_shares = Vec::new();
@@ -496,7 +498,7 @@ fn in_the_crowd_that_plays(config: &SimConfig, mut model: CostModel, creatures: 
         .map_or(counts.len(), |i| i + 1);
     let counts = &counts[first..needed.max(first + 1).min(counts.len())];
     model.rigid_shares = rigid_shares(config, &model, counts, Some(&mut crowd), effort);
-    let kept = (creatures < simlod::PARALLEL_MIN_CREATURES)
+    let kept = (!in_a_crowd)
         .then(|| "no crowd: the crowd shares, for a crowd a new round may bring, from the file, not measured".into());
     (model, kept)
 }
