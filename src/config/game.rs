@@ -39,7 +39,7 @@ pub struct GameConfig {
 }
 
 /// The budget policy in the game, where the frame rate matters more than a reproducible run.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameBudgetInGame {
     /// Where the rules leave the adaptive mode off (`budget.adaptive_frames` at 0), the game
@@ -51,11 +51,28 @@ pub struct FrameBudgetInGame {
     /// their mean.
     #[serde(default)]
     pub adaptive_percentile: f32,
+    /// With a percentile, how many times the budget it is kept within, the mean frame within
+    /// the budget itself (see the rules' `budget.adaptive_percentile_limit`); 1, as a file
+    /// without it, the budget. 1 to 10.
+    #[serde(default = "FrameBudgetInGame::percentile_within_the_budget")]
+    pub adaptive_percentile_limit: f32,
     /// Whether the game measures the cost model on the machine that plays before its window
     /// opens (a second or two), in place of the file's, for the whole session. A file without
     /// it leaves the file's model.
     #[serde(default)]
     pub calibrate_at_start: bool,
+}
+
+/// A file without `frame_budget`: the rules as they are.
+impl Default for FrameBudgetInGame {
+    fn default() -> Self {
+        Self {
+            adaptive_frames: 0.0,
+            adaptive_percentile: 0.0,
+            adaptive_percentile_limit: Self::percentile_within_the_budget(),
+            calibrate_at_start: false,
+        }
+    }
 }
 
 impl FrameBudgetInGame {
@@ -65,7 +82,12 @@ impl FrameBudgetInGame {
         if rules.budget.adaptive_frames == 0.0 {
             rules.budget.adaptive_frames = self.adaptive_frames;
             rules.budget.adaptive_percentile = self.adaptive_percentile;
+            rules.budget.adaptive_percentile_limit = self.adaptive_percentile_limit;
         }
+    }
+
+    fn percentile_within_the_budget() -> f32 {
+        1.0
     }
 }
 
@@ -284,7 +306,9 @@ impl Validate for GameConfig {
         });
         v.nested("frame_budget", |v| {
             v.within("adaptive_frames", self.frame_budget.adaptive_frames, 0.0, 10_000.0);
-            super::validate_adaptive_percentile(v, "adaptive_percentile", self.frame_budget.adaptive_percentile);
+            let f = &self.frame_budget;
+            super::validate_adaptive_percentile(v, "adaptive_percentile", f.adaptive_percentile);
+            super::validate_adaptive_percentile_limit(v, "adaptive_percentile_limit", f.adaptive_percentile_limit);
         });
         let k = &self.creature_look;
         v.nested("creature_look", |v| {

@@ -28,7 +28,10 @@ pub use game::{
 };
 pub use loader::{RonAssetLoader, load_file, parse_ron};
 pub use overrides::Overrides;
-pub use rules::{BudgetRules, CameraRules, InfluenceRules, LevelRules, validate_adaptive_percentile};
+pub use rules::{
+    BudgetRules, CameraRules, InfluenceRules, LevelRules, validate_adaptive_percentile,
+    validate_adaptive_percentile_limit,
+};
 pub use scenario::{CreatureGroup, LevelPolicy, MAX_CREATURES, MAX_DURATION_S, Scenario};
 pub use validate::{ConfigError, Problem, Validate, Validator, number};
 

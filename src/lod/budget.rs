@@ -1121,6 +1121,9 @@ pub struct BudgetSummary {
     /// What the adaptive mode kept at the budget: 0 the mean frame, else this percentile of
     /// the last frames.
     pub adaptive_percentile: f32,
+    /// In the percentile mode, how many times the budget that percentile was kept within (the
+    /// mean within the budget itself).
+    pub adaptive_percentile_limit: f32,
 }
 
 impl Default for BudgetTally {
@@ -1148,16 +1151,19 @@ impl BudgetTally {
         self.model_us * self.correction + self.headroom_us
     }
 
-    /// The budget of `budget_ms` as the cost model is to spend it: less the headroom, over the
-    /// correction.
-    fn model_budget_us(&self, budget_ms: f32) -> f32 {
-        (budget_ms * 1e3 - self.headroom_us).max(0.0) / self.correction
+    /// The rules' budget as the cost model is to spend it, over the correction: the mean frame
+    /// within the budget, and in the percentile mode the percentile (the mean with its headroom)
+    /// within `adaptive_percentile_limit` times it.
+    fn model_budget_us(&self, rules: &BudgetRules) -> f32 {
+        let budget_us = rules.frame_budget_ms * 1e3;
+        let percentile_us = budget_us * rules.adaptive_percentile_limit - self.headroom_us;
+        percentile_us.min(budget_us).max(0.0) / self.correction
     }
 
     /// The adaptive mode after a frame: its measured time (taken, so that each frame counts
     /// once) corrects the cost model toward the mean frame; in the percentile mode, what the
     /// frame took beyond that prediction joins the last frames', whose percentile is kept free
-    /// of the budget. Frames that vary by a share of their work or by a stall alike then keep
+    /// of the budget (of its `adaptive_percentile_limit` times). Frames that vary by a share of their work or by a stall alike then keep
     /// that percentile within the budget, and a crowd at its floors is not held there by a
     /// stall many times its small prediction.
     fn correct(&mut self, rules: &BudgetRules) {
@@ -1201,6 +1207,7 @@ impl BudgetTally {
             adaptive: rules.adaptive_frames > 0.0,
             correction: self.correction,
             adaptive_percentile: rules.adaptive_percentile,
+            adaptive_percentile_limit: rules.adaptive_percentile_limit,
         }
     }
 
@@ -1852,7 +1859,7 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     if rules.adaptive_frames > 0.0 {
         tally.correct(rules);
     }
-    let decision = inputs.decide(&creatures, tally.model_budget_us(rules.frame_budget_ms), false);
+    let decision = inputs.decide(&creatures, tally.model_budget_us(rules), false);
     tally.record(&decision);
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
@@ -1885,11 +1892,7 @@ fn start_by_budget(
         return;
     }
     let now = inputs.clock.seconds() as f32;
-    let decision = inputs.decide(
-        &creatures,
-        tally.model_budget_us(inputs.config.rules.budget.frame_budget_ms),
-        true,
-    );
+    let decision = inputs.decide(&creatures, tally.model_budget_us(&inputs.config.rules.budget), true);
     let mut searched = decision.settled.iter().peekable();
     for (row, ((entity, c, &lod, _, mut choice), &level)) in creatures.iter_mut().zip(&decision.levels).enumerate() {
         if level != lod
@@ -2609,6 +2612,30 @@ mod tests {
         assert_eq!(recent.clone().percentile_with(1.0, 100, 100.0), 5.0);
         // A shorter window keeps only the newest.
         assert_eq!(recent.percentile_with(1.0, 1, 100.0), 1.0);
+    }
+
+    #[test]
+    fn the_percentile_mode_keeps_the_mean_within_the_budget_and_the_percentile_within_its_limit() {
+        let rules = |limit| BudgetRules {
+            frame_budget_ms: 10.0,
+            adaptive_percentile_limit: limit,
+            ..ron::from_str::<LevelRules>(include_str!("../../assets/rules/levels.ron"))
+                .unwrap()
+                .budget
+        };
+        let tally = |headroom_us| BudgetTally {
+            correction: 2.0,
+            headroom_us,
+            ..BudgetTally::default()
+        };
+        // Within the budget: 10 ms less 1 ms of slow frames, over a model that runs twice slow.
+        assert_eq!(tally(1000.0).model_budget_us(&rules(1.0)), 4500.0);
+        // Within 1.2 times it, 12 ms less 1 ms: but the mean is held at the budget, 10 ms.
+        assert_eq!(tally(1000.0).model_budget_us(&rules(1.2)), 5000.0);
+        // Frames slower than the room between: the percentile's limit holds the mean under.
+        assert_eq!(tally(3000.0).model_budget_us(&rules(1.2)), 4500.0);
+        // Slow frames beyond the limit itself leave nothing to spend.
+        assert_eq!(tally(20_000.0).model_budget_us(&rules(1.2)), 0.0);
     }
 
     #[test]

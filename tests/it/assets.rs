@@ -179,6 +179,25 @@ fn an_emergency_line_under_the_budget_is_refused() {
 }
 
 #[test]
+fn a_percentile_limit_under_the_budget_is_refused() {
+    let err = load_error(
+        "adaptive_percentile_limit",
+        "rules/levels.ron",
+        &edited(
+            "rules/levels.ron",
+            "adaptive_percentile_limit: 1.0",
+            "adaptive_percentile_limit: 0.9",
+        ),
+    );
+    assert_names(
+        &err,
+        "rules/levels.ron",
+        "budget.adaptive_percentile_limit",
+        "must be between 1 and 10, got 0.9",
+    );
+}
+
+#[test]
 fn a_percentile_under_the_median_for_the_adaptive_mode_is_refused() {
     let err = load_error(
         "adaptive_percentile",

@@ -263,6 +263,32 @@ fn a_bad_flag_or_file_is_a_clear_error_with_status_2() {
         &["run", "--policy", "budget", "--adaptive-percentile", "99"],
         "--adaptive",
     );
+    refused(
+        &[
+            "run",
+            "--policy",
+            "budget",
+            "--adaptive",
+            "30",
+            "--adaptive-percentile",
+            "99",
+            "--adaptive-percentile-limit",
+            "0.8",
+        ],
+        "between 1 and 10 times the budget, got 0.8",
+    );
+    refused(
+        &[
+            "run",
+            "--policy",
+            "budget",
+            "--adaptive",
+            "30",
+            "--adaptive-percentile-limit",
+            "1.2",
+        ],
+        "--adaptive-percentile",
+    );
     refused(&["run", "--frame-budget=-1"], "10000 ms");
     refused(&["run", "--frame-budget", "lots"], "lots");
     refused(&["play", "--frame-budget=-1"], "10000 ms");

@@ -631,21 +631,26 @@ fn the_budget_at_every_crowd_size_can_price_each_sizes_games_by_a_model_measured
 fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys_more_with_more() {
     let dir = scratch_dir("budget_scale");
     let file = dir.join("budget_scale.ron");
-    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], adaptive_percentiles: [0.0, 99.0], seconds: 0.4, warm_up_s: 0.1, seed: 3)";
+    let settings = "(creatures: [30, 90], budgets_ms: [0.4, 3.0], adaptive_frames: [0.0, 20.0], adaptive_percentiles: [0.0, 99.0], adaptive_percentile_limits: [1.0, 1.5], seconds: 0.4, warm_up_s: 0.1, seed: 3)";
     std::fs::write(&file, format!("(full: {settings}, quick: {settings})")).unwrap();
     let said = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap();
     every_file_it_says_it_wrote_exists(&said, &dir);
     let rows = table(&dir.join("budget-scale.csv"));
-    let games: Vec<[&str; 4]> = (rows[1..].iter())
-        .map(|r| [0, 1, 2, 3].map(|i| r[i].as_str()))
+    let games: Vec<[&str; 5]> = (rows[1..].iter())
+        .map(|r| [0, 1, 2, 3, 15].map(|i| r[i].as_str()))
         .collect();
     let mut want = Vec::new();
     for n in ["30", "90"] {
         for b in ["0.4", "3"] {
             // The cost model alone once; the adaptive mode keeping the mean, then the 99th
-            // percentile.
-            for (a, p) in [("0", "0"), ("20", "0"), ("20", "99")] {
-                want.push([n, b, a, p]);
+            // percentile within the budget and within 1.5 times it.
+            for (a, p, limit) in [
+                ("0", "0", "1"),
+                ("20", "0", "1"),
+                ("20", "99", "1"),
+                ("20", "99", "1.5"),
+            ] {
+                want.push([n, b, a, p, limit]);
             }
         }
     }
@@ -669,12 +674,29 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
     assert!(rigid("90", "3") > rigid("90", "0.4"), "{rows:?}");
     assert_eq!(
         said.matches("\n| 30 |").count() + said.matches("\n| 90 |").count(),
-        12,
+        16,
         "{said}"
     );
-    assert!(said.contains("of 12 games"), "{said}");
+    assert!(said.contains("of 16 games"), "{said}");
+    // Kept: the mean no more than 10 % over the budget, the 99th percentile no more than 25 %;
+    // spent too: the mean no more than 10 % under it either.
+    let (mut kept, mut spent) = (0, 0);
+    for r in &rows[1..] {
+        let (budget, mean, p99) = (number(r, 1), number(r, 5), number(r, 6));
+        let within = mean <= 1.1 * budget && p99 <= 1.25 * budget;
+        kept += usize::from(within);
+        spent += usize::from(within && mean >= 0.9 * budget);
+    }
+    let counts = format!(
+        "Kept in {kept} of 16 games, and spent too (the mean frame also no more than 10 % under the budget) in {spent};"
+    );
+    assert!(said.contains(&counts), "{counts} in {said}");
     // The 99th percentile among the last 300 frames, where three lie beyond it.
     assert!(said.contains("| 20 frames, 99th percentile of 300 |"), "{said}");
+    assert!(
+        said.contains("| 20 frames, 99th percentile of 300 within 1.5 times the budget |"),
+        "{said}"
+    );
     // Each game's frame predicted over its prediction, in its row in the games' order, and how
     // many were within 10 % of it either way.
     let reported: Vec<f64> = (said.lines())
@@ -687,7 +709,7 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         assert!((reported - ratio).abs() < 0.006, "{reported} for {r:?}");
         honest += usize::from((ratio - 1.0).abs() <= 0.1);
     }
-    assert_eq!(reported.len(), 12, "{said}");
+    assert_eq!(reported.len(), 16, "{said}");
     assert!(
         said.contains(&format!("within 10 % of its prediction in {honest}.")),
         "{said}"
@@ -738,11 +760,12 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         assert!(said.contains(&row), "{row} in {said}");
     }
     // Settings out of range are refused with the field named: sizes out of order, a warm-up as
-    // long as the game, a percentile under 50.
+    // long as the game, a percentile under 50, a limit under the budget.
     for (from, to, named) in [
         ("[30, 90]", "[90, 30]", "creatures"),
         ("warm_up_s: 0.1", "warm_up_s: 0.4", "warm_up_s"),
         ("99.0]", "30.0]", "adaptive_percentiles[1]`: must be 0"),
+        ("1.5]", "0.5]", "adaptive_percentile_limits[1]`: must be"),
     ] {
         std::fs::write(&file, format!("(full: {0}, quick: {0})", settings.replace(from, to))).unwrap();
         let err = experiments::run_named("budget-scale", &default_config(), &file, &quick(&dir)).unwrap_err();

@@ -230,6 +230,13 @@ fn the_shipped_game_file_loads_and_a_bad_colour_is_named() {
         err.contains("`level_colours_srgb.PointMass.0`") && err.contains("between 0 and 1"),
         "{err}"
     );
+    let limit = "adaptive_percentile_limit: 1.2";
+    std::fs::write(&bad, text.replacen(limit, "adaptive_percentile_limit: 0.5", 1)).unwrap();
+    let err = load_file::<GameConfig>(&bad).unwrap_err().to_string();
+    assert!(
+        err.contains("`frame_budget.adaptive_percentile_limit`") && err.contains("between 1 and 10, got 0.5"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -434,15 +441,20 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     let looks: GameConfig = load_file(&root.join("game.ron")).unwrap();
     let shipped = &looks.frame_budget;
     assert_eq!(
-        (shipped.adaptive_frames, shipped.adaptive_percentile),
-        (30.0, 99.0),
+        (
+            shipped.adaptive_frames,
+            shipped.adaptive_percentile,
+            shipped.adaptive_percentile_limit
+        ),
+        (30.0, 99.0, 1.2),
         "as shipped"
     );
     app.insert_resource(GameSettings(looks.clone()));
     let_the_first_loads_settle(&mut app);
     let adaptive = |app: &App| {
         running_and_next(app, |c| {
-            (c.rules.budget.adaptive_frames, c.rules.budget.adaptive_percentile)
+            let b = &c.rules.budget;
+            (b.adaptive_frames, b.adaptive_percentile, b.adaptive_percentile_limit)
         })
     };
     // An edit of the rules (which leave the adaptive mode off) runs with the game's.
@@ -456,9 +468,14 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
-    assert_eq!(adaptive(&app), [(30.0, 99.0); 2]);
+    assert_eq!(adaptive(&app), [(30.0, 99.0, 1.2); 2]);
     // The game's setting edited: at once, running and for the next rounds.
     edit(&game_file, "adaptive_frames: 30.0", "adaptive_frames: 0.0");
+    edit(
+        &game_file,
+        "adaptive_percentile_limit: 1.2",
+        "adaptive_percentile_limit: 1.5",
+    );
     edit(&game_file, "adaptive_percentile: 99.0", "adaptive_percentile: 0.0");
     update_until(&mut app, "the game file's edit", |app| {
         app.world()
@@ -468,7 +485,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
             .adaptive_percentile
             == 0.0
     });
-    assert_eq!(adaptive(&app), [(0.0, 0.0); 2]);
+    assert_eq!(adaptive(&app), [(0.0, 0.0, 1.5); 2]);
     // Rules that set their own adaptive mode keep it whatever the game says.
     edit(&rules_file, "adaptive_frames: 0.0,", "adaptive_frames: 12.0,");
     update_until(&mut app, "the rules' own adaptive mode", |app| {
@@ -478,7 +495,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the second game file's edit", |app| {
         app.world().resource::<GameSettings>().0.frame_budget.adaptive_frames == 45.0
     });
-    assert_eq!(adaptive(&app), [(12.0, 0.0); 2]);
+    assert_eq!(adaptive(&app), [(12.0, 0.0, 1.0); 2]);
 }
 
 #[test]

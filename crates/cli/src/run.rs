@@ -34,6 +34,10 @@ pub(crate) struct RunArgs {
     /// 99 keeps the slowest of every hundred), not their mean.
     #[arg(long, requires = "adaptive", allow_negative_numbers = true, value_parser = adaptive_percentile)]
     pub(crate) adaptive_percentile: Option<f32>,
+    /// With `--adaptive-percentile`, how many times the budget that percentile is kept within,
+    /// the mean within the budget itself (1 to 10; 1 without it: the budget).
+    #[arg(long, requires = "adaptive_percentile", allow_negative_numbers = true, value_parser = adaptive_percentile_limit)]
+    pub(crate) adaptive_percentile_limit: Option<f32>,
 }
 
 fn adaptive_frames(s: &str) -> Result<f32, String> {
@@ -51,6 +55,15 @@ fn adaptive_percentile(s: &str) -> Result<f32, String> {
         Ok(v)
     } else {
         Err(format!("must be between 50 and 100, got {v}"))
+    }
+}
+
+fn adaptive_percentile_limit(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("not a number: {s:?}"))?;
+    if (1.0..=10.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("must be between 1 and 10 times the budget, got {v}"))
     }
 }
 
@@ -87,6 +100,7 @@ impl RunArgs {
         if let Some(frames) = self.adaptive {
             config.rules.budget.adaptive_frames = frames;
             config.rules.budget.adaptive_percentile = self.adaptive_percentile.unwrap_or(0.0);
+            config.rules.budget.adaptive_percentile_limit = self.adaptive_percentile_limit.unwrap_or(1.0);
         }
         let mut ran = self.scenario.what_ran(&config);
         if self.calibrate {
@@ -227,8 +241,12 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
             let keeps = match b.adaptive_percentile {
                 0.0 => String::new(),
                 p => format!(
-                    " keeping the {p}th percentile of the last {} frames within the budget",
-                    simlod::lod::percentile_window(config.rules.budget.adaptive_frames, p)
+                    " keeping the {p}th percentile of the last {} frames within {} and the mean within the budget",
+                    simlod::lod::percentile_window(config.rules.budget.adaptive_frames, p),
+                    match config.rules.budget.adaptive_percentile_limit {
+                        1.0 => "it".to_owned(),
+                        limit => format!("{limit} times it"),
+                    }
                 ),
             };
             format!(

@@ -254,7 +254,7 @@ fn stats_text(
             if rules.budget.adaptive_frames > 0.0 {
                 let keeps = match rules.budget.adaptive_percentile {
                     0.0 => String::new(),
-                    p => format!(" ({p}th percentile)"),
+                    p => format!(" ({p}th percentile within {}x)", rules.budget.adaptive_percentile_limit),
                 };
                 format!("   adaptive{keeps}: model x {:.2}", budget.correction)
             } else {

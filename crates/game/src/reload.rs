@@ -290,6 +290,7 @@ fn apply_looks(
         for budget in [&mut base.rules.budget, &mut live.rules.budget] {
             budget.adaptive_frames = rules.budget.adaptive_frames;
             budget.adaptive_percentile = rules.budget.adaptive_percentile;
+            budget.adaptive_percentile_limit = rules.budget.adaptive_percentile_limit;
         }
     }
     settings.0 = new.clone();

@@ -37,6 +37,10 @@ pub struct BudgetScaleSettings {
     /// 50 to 100 that percentile of the frames (a file without it: the mean only).
     #[serde(default = "BudgetScaleSettings::mean_only")]
     pub adaptive_percentiles: Vec<f32>,
+    /// What each percentile above 0 is kept within, each a game: times the budget, the mean
+    /// frame within the budget itself (1 to 10; a file without it: the budget only).
+    #[serde(default = "BudgetScaleSettings::within_the_budget")]
+    pub adaptive_percentile_limits: Vec<f32>,
     /// Simulated seconds of each game.
     pub seconds: f32,
     /// Simulated seconds at the start of each game left out of its mean, its 99th percentile
@@ -57,9 +61,13 @@ impl BudgetScaleSettings {
         vec![0.0]
     }
 
+    fn within_the_budget() -> Vec<f32> {
+        vec![1.0]
+    }
+
     /// The adaptive mode's settings, each a game at every size and budget: (frames,
-    /// percentile), the cost model alone once.
-    fn adaptive_settings(&self) -> Vec<(f32, f32)> {
+    /// percentile, its limit), the cost model alone once, the mean once.
+    fn adaptive_settings(&self) -> Vec<Adaptive> {
         let mut settings = Vec::new();
         for &frames in &self.adaptive_frames {
             let percentiles: &[f32] = if frames > 0.0 {
@@ -67,7 +75,14 @@ impl BudgetScaleSettings {
             } else {
                 &[0.0]
             };
-            settings.extend(percentiles.iter().map(|&p| (frames, p)));
+            for &p in percentiles {
+                let limits: &[f32] = if p > 0.0 {
+                    &self.adaptive_percentile_limits
+                } else {
+                    &[1.0]
+                };
+                settings.extend(limits.iter().map(|&limit| (frames, p, limit)));
+            }
         }
         settings
     }
@@ -100,6 +115,15 @@ impl Validate for BudgetScaleSettings {
         for (i, &p) in self.adaptive_percentiles.iter().enumerate() {
             simlod::config::validate_adaptive_percentile(v, &format!("adaptive_percentiles[{i}]"), p);
         }
+        v.require(
+            !self.adaptive_percentile_limits.is_empty(),
+            "adaptive_percentile_limits",
+            "must list at least one limit (1: the budget)",
+        );
+        for (i, &limit) in self.adaptive_percentile_limits.iter().enumerate() {
+            let field = format!("adaptive_percentile_limits[{i}]");
+            simlod::config::validate_adaptive_percentile_limit(v, &field, limit);
+        }
         v.range("seconds", self.seconds, 1.0 / 30.0, 600.0);
         v.require(
             (0.0..self.seconds).contains(&self.warm_up_s),
@@ -112,6 +136,10 @@ impl Validate for BudgetScaleSettings {
     }
 }
 
+/// A setting of the adaptive mode: the frames its correction is smoothed over (0: off), the
+/// percentile it keeps (0: the mean) and how many times the budget it keeps it within.
+type Adaptive = (f32, f32, f32);
+
 /// One game: a crowd size, a budget, a setting of the adaptive mode.
 #[derive(Clone, Debug, Serialize)]
 struct Game {
@@ -120,6 +148,8 @@ struct Game {
     adaptive_frames: f32,
     /// 0: the adaptive mode keeps the mean frame at the budget; else this percentile.
     adaptive_percentile: f32,
+    /// The percentile kept within this many times the budget (the mean within the budget).
+    adaptive_percentile_limit: f32,
     /// The frames after the warm-up.
     frames: usize,
     mean_frame_ms: f64,
@@ -141,6 +171,14 @@ struct Game {
 }
 
 impl Game {
+    fn setting(&self) -> Adaptive {
+        (
+            self.adaptive_frames,
+            self.adaptive_percentile,
+            self.adaptive_percentile_limit,
+        )
+    }
+
     fn mean_over_budget(&self) -> f64 {
         self.mean_frame_ms / f64::from(self.budget_ms)
     }
@@ -149,6 +187,12 @@ impl Game {
     /// percentile no more than 25 % over.
     fn kept(&self) -> bool {
         self.mean_frame_ms <= 1.1 * f64::from(self.budget_ms) && self.p99_frame_ms <= 1.25 * f64::from(self.budget_ms)
+    }
+
+    /// Whether the budget was kept and spent: kept, and the mean frame no more than 10 % under
+    /// it either.
+    fn kept_and_spent(&self) -> bool {
+        self.kept() && self.mean_frame_ms >= 0.9 * f64::from(self.budget_ms)
     }
 
     /// The frame predicted (the mean, or the percentile the adaptive mode keeps) as measured,
@@ -176,8 +220,12 @@ impl Game {
             (0.0, _) => "off".into(),
             (frames, 0.0) => format!("{frames} frames"),
             (frames, p) => format!(
-                "{frames} frames, {p}th percentile of {}",
-                simlod::lod::percentile_window(frames, p)
+                "{frames} frames, {p}th percentile of {}{}",
+                simlod::lod::percentile_window(frames, p),
+                match self.adaptive_percentile_limit {
+                    1.0 => String::new(),
+                    limit => format!(" within {limit} times the budget"),
+                }
             ),
         }
     }
@@ -199,7 +247,7 @@ fn game(
     s: &BudgetScaleSettings,
     creatures: u32,
     budget_ms: f32,
-    (adaptive_frames, adaptive_percentile): (f32, f32),
+    (adaptive_frames, adaptive_percentile, adaptive_percentile_limit): Adaptive,
 ) -> Game {
     let mut c = scaled(config, creatures, LevelPolicy::Budget);
     c.scenario.seed = s.seed;
@@ -208,7 +256,13 @@ fn game(
         budget.frame_budget_ms,
         budget.adaptive_frames,
         budget.adaptive_percentile,
-    ) = (budget_ms, adaptive_frames, adaptive_percentile);
+        budget.adaptive_percentile_limit,
+    ) = (
+        budget_ms,
+        adaptive_frames,
+        adaptive_percentile,
+        adaptive_percentile_limit,
+    );
     let mut sim = HeadlessSim::new(c);
     // The first moments build the world's bodies and search every creature for contacts once.
     let warm_up = timed_frames(&mut sim, f64::from(s.warm_up_s));
@@ -224,6 +278,7 @@ fn game(
         budget_ms,
         adaptive_frames,
         adaptive_percentile,
+        adaptive_percentile_limit,
         frames: frames.len(),
         mean_frame_ms,
         p99_frame_ms: p99_ms(&frames),
@@ -322,7 +377,7 @@ fn machine_spread(budget_ms: f32, threads: usize, frames: usize) -> MachineSprea
     }
 }
 
-const HEADER: &str = "creatures,budget_ms,adaptive_frames,adaptive_percentile,frames,mean_frame_ms,p99_frame_ms,held_frame_ms,predicted_mean_ms,decisions_over_budget,decisions,hybrid,rigid,warm_up_slowest_ms,median_frame_ms";
+const HEADER: &str = "creatures,budget_ms,adaptive_frames,adaptive_percentile,frames,mean_frame_ms,p99_frame_ms,held_frame_ms,predicted_mean_ms,decisions_over_budget,decisions,hybrid,rigid,warm_up_slowest_ms,median_frame_ms,adaptive_percentile_limit";
 
 /// Runs the experiment from `file`: every game, one at a time; writes its CSV, plot, JSON and
 /// report and returns what it says.
@@ -374,7 +429,7 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
     for g in &games {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{},{},{:.1},{:.1},{:.4},{:.4}",
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{:.4},{},{},{:.1},{:.1},{:.4},{:.4},{}",
             g.creatures,
             g.budget_ms,
             g.adaptive_frames,
@@ -389,7 +444,8 @@ pub fn run(config: &SimConfig, file: &Path, options: &Options) -> Result<String,
             g.hybrid,
             g.rigid,
             g.warm_up_slowest_ms,
-            g.median_frame_ms
+            g.median_frame_ms,
+            g.adaptive_percentile_limit
         );
     }
     draw(&games, &s, options)?;
@@ -414,9 +470,10 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
     let panel = |what: &str, line: (&str, f64), over_budget: fn(&Game) -> f64| {
         let mut series = Vec::new();
         for (i, &b) in s.budgets_ms.iter().enumerate() {
-            for (frames, percentile) in s.adaptive_settings() {
+            for setting in s.adaptive_settings() {
+                let (frames, percentile, limit) = setting;
                 let these: Vec<&Game> = (games.iter())
-                    .filter(|g| g.budget_ms == b && (g.adaptive_frames, g.adaptive_percentile) == (frames, percentile))
+                    .filter(|g| g.budget_ms == b && g.setting() == setting)
                     .collect();
                 let points = these
                     .iter()
@@ -425,7 +482,8 @@ fn draw(games: &[Game], s: &BudgetScaleSettings, options: &Options) -> Result<()
                 let mark = match (frames, percentile) {
                     (0.0, _) => Mark::Line,
                     (_, 0.0) => Mark::Dashed,
-                    _ => Mark::Points,
+                    _ if limit == 1.0 => Mark::Points,
+                    _ => Mark::Rings,
                 };
                 let setting = these.first().map_or_else(String::new, |g| g.adaptive());
                 let label = if frames > 0.0 {
@@ -525,6 +583,7 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, me
         );
     }
     let kept = games.iter().filter(|g| g.kept()).count();
+    let spent = games.iter().filter(|g| g.kept_and_spent()).count();
     let honest = games.iter().filter(|g| g.predicted_within_10_percent()).count();
     let of_the_mean = games.iter().filter(|g| g.predicts_the_mean()).count();
     let median_honest = (games.iter())
@@ -533,7 +592,7 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, me
         .count();
     let _ = write!(
         report,
-        "\nKept in {kept} of {} games; the frame predicted within 10 % of its prediction in {honest}. Of the \
+        "\nKept in {kept} of {} games, and spent too (the mean frame also no more than 10 % under the budget) in {spent}; the frame predicted within 10 % of its prediction in {honest}. Of the \
          {of_the_mean} games whose prediction is of the mean, the median frame within 10 % of it in {median_honest}.\n",
         games.len()
     );
