@@ -691,6 +691,31 @@ fn the_budget_at_every_crowd_size_plays_each_size_budget_and_correction_and_buys
         "Kept in {kept} of 16 games, and spent too (the mean frame also no more than 10 % under the budget) in {spent};"
     );
     assert!(said.contains(&counts), "{counts} in {said}");
+    // As much as the crowd could use: where the size's game on the cost model alone at the
+    // largest budget (3 ms) left more than a tenth of it, no more than 10 % under what it spent.
+    let usable: Vec<(&str, f64)> = (rows[1..].iter())
+        .filter(|r| r[2] == "0" && r[1] == "3" && number(r, 5) < 0.9 * 3.0)
+        .map(|r| (r[0].as_str(), number(r, 5)))
+        .collect();
+    let could = (rows[1..].iter())
+        .filter(|r| {
+            let (budget, mean, p99) = (number(r, 1), number(r, 5), number(r, 6));
+            let used = usable
+                .iter()
+                .find(|(n, _)| *n == r[0])
+                .map_or(budget, |u| u.1.min(budget));
+            mean <= 1.1 * budget && p99 <= 1.25 * budget && mean >= 0.9 * used
+        })
+        .count();
+    if usable.is_empty() {
+        assert!(!said.contains("as much as the crowd could use"), "{said}");
+    } else {
+        let sizes: Vec<String> = (usable.iter())
+            .map(|(n, ms)| format!("{n} creatures {ms:.2} ms"))
+            .collect();
+        let words = format!("spent: {}) in {could}.", sizes.join(", "));
+        assert!(said.contains(&words), "{words} in {said}");
+    }
     // The 99th percentile among the last 300 frames, where three lie beyond it.
     assert!(said.contains("| 20 frames, 99th percentile of 300 |"), "{said}");
     assert!(

@@ -195,6 +195,14 @@ impl Game {
         self.kept() && self.mean_frame_ms >= 0.9 * f64::from(self.budget_ms)
     }
 
+    /// Whether the budget was kept and as much of it spent as the crowd could use: kept, and the
+    /// mean frame no more than 10 % under the budget or under `usable_ms`, the most the crowd
+    /// was seen to use (see [`usable_by_size`]).
+    fn kept_and_spent_what_it_could(&self, usable_ms: Option<f64>) -> bool {
+        let budget_ms = f64::from(self.budget_ms);
+        self.kept() && self.mean_frame_ms >= 0.9 * usable_ms.map_or(budget_ms, |u| u.min(budget_ms))
+    }
+
     /// The frame predicted (the mean, or the percentile the adaptive mode keeps) as measured,
     /// over the prediction (which can be well under the budget: the choice buys no level worth
     /// less than its least benefit per microsecond, and none above a creature's dearest).
@@ -234,6 +242,19 @@ impl Game {
     fn predicted_within_10_percent(&self) -> bool {
         (self.measured_over_predicted() - 1.0).abs() <= 0.1
     }
+}
+
+/// The most each crowd size was seen to use, ms a frame: the mean frame of its game on the cost
+/// model alone (reproducible, no headroom kept) at the largest budget, where that left more than
+/// a tenth of it unspent (every creature at its dearest level, or no level left worth its cost);
+/// none where it spent it, or no such game was played.
+fn usable_by_size(games: &[Game]) -> std::collections::BTreeMap<u32, f64> {
+    let largest = games.iter().map(|g| g.budget_ms).fold(0.0, f32::max);
+    (games.iter())
+        .filter(|g| g.adaptive_frames == 0.0 && g.budget_ms == largest)
+        .filter(|g| g.mean_frame_ms < 0.9 * f64::from(largest))
+        .map(|g| (g.creatures, g.mean_frame_ms))
+        .collect()
 }
 
 /// Whether the adaptive mode, so set, keeps a percentile of the frames at the budget (else the
@@ -584,6 +605,22 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, me
     }
     let kept = games.iter().filter(|g| g.kept()).count();
     let spent = games.iter().filter(|g| g.kept_and_spent()).count();
+    let usable = usable_by_size(games);
+    let could = (games.iter())
+        .filter(|g| g.kept_and_spent_what_it_could(usable.get(&g.creatures).copied()))
+        .count();
+    let usable_words = if usable.is_empty() {
+        String::new()
+    } else {
+        let sizes: Vec<String> = (usable.iter())
+            .map(|(n, ms)| format!("{n} creatures {ms:.2} ms"))
+            .collect();
+        format!(
+            " Spent as much as the crowd could use (where its game on the cost model alone at the largest budget left more than \
+             a tenth of it unspent, no more than 10 % under what that game spent: {}) in {could}.",
+            sizes.join(", ")
+        )
+    };
     let honest = games.iter().filter(|g| g.predicted_within_10_percent()).count();
     let of_the_mean = games.iter().filter(|g| g.predicts_the_mean()).count();
     let median_honest = (games.iter())
@@ -593,7 +630,7 @@ fn report(games: &[Game], machine: &[MachineSpread], s: &BudgetScaleSettings, me
     let _ = write!(
         report,
         "\nKept in {kept} of {} games, and spent too (the mean frame also no more than 10 % under the budget) in {spent}; the frame predicted within 10 % of its prediction in {honest}. Of the \
-         {of_the_mean} games whose prediction is of the mean, the median frame within 10 % of it in {median_honest}.\n",
+         {of_the_mean} games whose prediction is of the mean, the median frame within 10 % of it in {median_honest}.{usable_words}\n",
         games.len()
     );
     let _ = write!(
