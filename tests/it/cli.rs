@@ -440,7 +440,15 @@ fn run_with_calibrate_plays_by_a_model_measured_before_it_even_where_the_rules_h
     let out = simlod(
         &[
             &args[..],
-            &["--calibrate", "--adaptive", "30", "--adaptive-percentile", "99"],
+            &[
+                "--calibrate",
+                "--adaptive",
+                "30",
+                "--adaptive-percentile",
+                "99",
+                "--adaptive-percentile-limit",
+                "1.2",
+            ],
         ]
         .concat(),
     );
@@ -458,6 +466,9 @@ fn run_with_calibrate_plays_by_a_model_measured_before_it_even_where_the_rules_h
     let budget = &summary["budget"];
     assert_eq!(budget["adaptive"], true, "{budget}");
     assert_eq!(budget["adaptive_percentile"], 99.0, "{budget}");
+    // The limit as it was given, not as an f32 widened to 1.2000000476837158.
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(r#""adaptive_percentile_limit":1.2,"#), "{stdout}");
     // A model of zeros would make every creature rigid: the measured one prices them, and a
     // millisecond holds a few at most.
     let rigid = summary["levels_mean"]["rigid"].as_f64().unwrap();

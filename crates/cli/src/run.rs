@@ -114,6 +114,7 @@ impl RunArgs {
             json["policy"] = ran.policy.into();
             json["rules"] = ran.rules.display().to_string().into();
             json["cost_model"] = ran.cost_model.into();
+            simlod_lab::experiments::shortest_floats(&mut json);
             println!("{json}");
         } else {
             print_summary(self, &summary, &config, &ran);

@@ -228,6 +228,30 @@ pub fn write_out(out: &Path, file: &str, text: &str) -> Result<PathBuf, LabError
     Ok(path)
 }
 
+/// Every number in `value` that is an `f32` widened (`serde_json` keeps its numbers as `f64`, so
+/// an `f32` of 1.2 would print as 1.2000000476837158) written as the `f32` prints: the figures
+/// in a JSON summary read as they were set and measured. A number exactly an `f32` is taken for
+/// one; its shortest form as an `f32` is the same value to within an `f32`'s precision.
+pub fn shortest_floats(value: &mut serde_json::Value) {
+    use serde_json::Value;
+    match value {
+        Value::Number(n) => {
+            let Some(x) = n.as_f64().filter(|_| n.is_f64()) else {
+                return;
+            };
+            let narrow = x as f32;
+            if f64::from(narrow) == x
+                && let Some(short) = (narrow.to_string().parse::<f64>().ok()).and_then(serde_json::Number::from_f64)
+            {
+                *n = short;
+            }
+        }
+        Value::Array(items) => items.iter_mut().for_each(shortest_floats),
+        Value::Object(fields) => fields.values_mut().for_each(shortest_floats),
+        Value::Null | Value::Bool(_) | Value::String(_) => {}
+    }
+}
+
 /// What an experiment leaves in its `<name>.json`: its summary figures and the report's
 /// section on it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -257,7 +281,9 @@ impl ExperimentRecord {
     /// wrote before.
     pub fn save(&self, out: &Path, other: &[&str]) -> Result<String, LabError> {
         let name = &self.experiment;
-        let json = serde_json::to_string_pretty(self).expect("a record serialises");
+        let mut record = serde_json::to_value(self).expect("a record serialises");
+        shortest_floats(&mut record);
+        let json = serde_json::to_string_pretty(&record).expect("a record serialises");
         write_out(out, &format!("{name}.json"), &(json + "\n"))?;
         let report = report::write(out)?;
         let report = report
@@ -405,5 +431,21 @@ pub fn run_named(name: &str, config: &SimConfig, file: &Path, options: &Options)
             "no experiment {name:?}; there are {}",
             ALL.join(", ")
         ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shortest_floats;
+
+    #[test]
+    fn an_f32_in_a_summary_prints_as_it_was_set_and_an_f64_is_left_whole() {
+        let mut v = serde_json::json!({ "limit": 1.2f32, "ms": [0.4f32, 1.0f32], "exact": 0.1f64, "n": 3 });
+        shortest_floats(&mut v);
+        assert_eq!(v.to_string(), r#"{"exact":0.1,"limit":1.2,"ms":[0.4,1.0],"n":3}"#);
+        let third = 1.0f64 / 3.0;
+        let mut w = serde_json::json!(third);
+        shortest_floats(&mut w);
+        assert_eq!(w.as_f64(), Some(third));
     }
 }
