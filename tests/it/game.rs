@@ -230,7 +230,7 @@ fn the_shipped_game_file_loads_and_a_bad_colour_is_named() {
         err.contains("`level_colours_srgb.PointMass.0`") && err.contains("between 0 and 1"),
         "{err}"
     );
-    let limit = "adaptive_percentile_limit: 1.2";
+    let limit = "adaptive_percentile_limit: 1.15";
     std::fs::write(&bad, text.replacen(limit, "adaptive_percentile_limit: 0.5", 1)).unwrap();
     let err = load_file::<GameConfig>(&bad).unwrap_err().to_string();
     assert!(
@@ -446,7 +446,7 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
             shipped.adaptive_percentile,
             shipped.adaptive_percentile_limit
         ),
-        (30.0, 99.0, 1.2),
+        (30.0, 99.0, 1.15),
         "as shipped"
     );
     app.insert_resource(GameSettings(looks.clone()));
@@ -468,12 +468,12 @@ fn the_game_corrects_the_budget_by_its_frames_where_the_rules_do_not_and_an_edit
     update_until(&mut app, "the rules edit", |app| {
         app.world().resource::<SimConfig>().rules.min_dwell_s == 0.4
     });
-    assert_eq!(adaptive(&app), [(30.0, 99.0, 1.2); 2]);
+    assert_eq!(adaptive(&app), [(30.0, 99.0, 1.15); 2]);
     // The game's setting edited: at once, running and for the next rounds.
     edit(&game_file, "adaptive_frames: 30.0", "adaptive_frames: 0.0");
     edit(
         &game_file,
-        "adaptive_percentile_limit: 1.2",
+        "adaptive_percentile_limit: 1.15",
         "adaptive_percentile_limit: 1.5",
     );
     edit(&game_file, "adaptive_percentile: 99.0", "adaptive_percentile: 0.0");

@@ -30,8 +30,8 @@ pub(crate) struct RunArgs {
     /// over about this many (1 to 10000). It reads the clock: not reproducible.
     #[arg(long, allow_negative_numbers = true, value_parser = adaptive_frames)]
     pub(crate) adaptive: Option<f32>,
-    /// With `--adaptive`, the percentile of those frames kept within the budget (50 to 100;
-    /// 99 keeps the slowest of every hundred), not their mean.
+    /// With `--adaptive`, keep this percentile of the last frames within the budget, not their
+    /// mean (50 to 100; 99: the fourth slowest of the last 300).
     #[arg(long, requires = "adaptive", allow_negative_numbers = true, value_parser = adaptive_percentile)]
     pub(crate) adaptive_percentile: Option<f32>,
     /// With `--adaptive-percentile`, how many times the budget that percentile is kept within,
