@@ -54,7 +54,7 @@ pub struct FrameBudgetInGame {
     /// With a percentile, how many times the budget it is kept within, the mean frame within
     /// the budget itself (see the rules' `budget.adaptive_percentile_limit`); 1, as a file
     /// without it, the budget. 1 to 10.
-    #[serde(default = "FrameBudgetInGame::percentile_within_the_budget")]
+    #[serde(default = "super::BudgetRules::percentile_within_the_budget")]
     pub adaptive_percentile_limit: f32,
     /// Whether the game measures the cost model on the machine that plays before its window
     /// opens (a second or two), in place of the file's, for the whole session. A file without
@@ -69,7 +69,7 @@ impl Default for FrameBudgetInGame {
         Self {
             adaptive_frames: 0.0,
             adaptive_percentile: 0.0,
-            adaptive_percentile_limit: Self::percentile_within_the_budget(),
+            adaptive_percentile_limit: super::BudgetRules::percentile_within_the_budget(),
             calibrate_at_start: false,
         }
     }
@@ -84,10 +84,6 @@ impl FrameBudgetInGame {
             rules.budget.adaptive_percentile = self.adaptive_percentile;
             rules.budget.adaptive_percentile_limit = self.adaptive_percentile_limit;
         }
-    }
-
-    fn percentile_within_the_budget() -> f32 {
-        1.0
     }
 }
 

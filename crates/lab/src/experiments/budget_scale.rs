@@ -192,7 +192,7 @@ impl Game {
     /// Whether the budget was kept and spent: kept, and the mean frame no more than 10 % under
     /// it either.
     fn kept_and_spent(&self) -> bool {
-        self.kept() && self.mean_frame_ms >= 0.9 * f64::from(self.budget_ms)
+        self.kept_and_spent_what_it_could(None)
     }
 
     /// Whether the budget was kept and as much of it spent as the crowd could use: kept, and the
