@@ -229,6 +229,14 @@ impl CostModel {
         self.overhead_at_us(creatures, self.floors_only_us_per_creature, |s| s.floors_only)
     }
 
+    /// What the choice adds for each creature of `creatures` whose benefits it works out,
+    /// beyond its pass over it (a creature it leaves quiet costs only the pass: the budget
+    /// policy's incremental choice).
+    pub fn evaluation_us(&self, creatures: usize) -> f32 {
+        let n = creatures.max(1);
+        ((self.overhead_us(n) - self.floors_only_overhead_us(n)) / n as f32).max(0.0)
+    }
+
     /// The fixed cost, and the choice at `per_creature_us` and its `share` in a crowd.
     fn overhead_at_us(&self, creatures: usize, per_creature_us: f32, share: fn(&CrowdShares) -> f32) -> f32 {
         let share = self.shares_in_crowd(creatures as u32).map_or(1.0, |s| share(&s));

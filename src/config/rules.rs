@@ -139,9 +139,22 @@ pub struct BudgetRules {
     /// it run 15 % over, so the mean comes nearer the budget. 1 to 10.
     #[serde(default = "BudgetRules::percentile_within_the_budget")]
     pub adaptive_percentile_limit: f32,
+    /// true (the default): the incremental choice. A crowd's quiet creatures (out of view in a
+    /// tile of the court the view cone misses, at their floor, not followed) wait in groups,
+    /// their benefits worked out only for a group that reaches the front with room for a step:
+    /// the same levels as working out every creature, at the cost of the few, where working out
+    /// every creature would cost more than the room it leaves. false: every creature's benefits
+    /// are worked out at every decision.
+    #[serde(default = "BudgetRules::incremental")]
+    pub incremental_choice: bool,
 }
 
 impl BudgetRules {
+    /// `incremental_choice` where a file leaves it out.
+    fn incremental() -> bool {
+        true
+    }
+
     /// `adaptive_percentile_limit` where a file leaves it out: the budget itself.
     pub(crate) fn percentile_within_the_budget() -> f32 {
         1.0

@@ -141,16 +141,17 @@ impl Candidate<'_> {
                 p.cost_us[to as usize] - cost
             },
             running_us: running(to) - running(at),
+            group: false,
         })
     }
 
     /// Lists its steps up its upper hull from its floor, in turn (a loop, not an iterator of
     /// them: each step is written once, where the iterator's moves of it stalled the listing).
-    fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, listed: &mut Listing) {
+    fn list_hull(&self, creature: u32, hull: &Hull, p: &Priced, mut listed: impl FnMut(Step)) {
         let top = self.levels.iter().max().copied();
         let mut next = self.step_from(creature, self.floor, hull, p);
         while let Some(step) = next {
-            listed.push(step, hull);
+            listed(step);
             // Nothing is above its kind's top level.
             next = if Some(step.to) == top {
                 None
@@ -180,6 +181,9 @@ trait Crowd<'a>: Sync {
     fn candidate(&self, i: usize) -> Candidate<'a>;
     /// The `i`-th's exact rigid benefit, settled.
     fn settle(&mut self, i: usize, rigid_benefit: f32);
+    /// The steps up the hulls of the quiet creatures of `group` ([`QuietGroups`]) into
+    /// `opened`, each creature marked in `settled_now` as it is: none where there are no groups.
+    fn open(&self, _group: usize, _hull: &Hull, _settled_now: &mut [bool], _opened: &mut Vec<Step>) {}
 }
 
 impl<'a> Crowd<'a> for [Candidate<'a>] {
@@ -213,6 +217,9 @@ pub struct Allocation<S = ()> {
     /// Candidates whose benefit had to be settled (each one's search for contacts), in the
     /// order settled, with what the settling returned beside the benefit.
     pub settled: Vec<(usize, S)>,
+    /// Quiet creatures whose benefits were never worked out: their groups not opened (the
+    /// incremental choice).
+    pub quiet: usize,
 }
 
 /// One step up a creature's levels on the knapsack's upper hull; while `bound`, its ratio is
@@ -232,6 +239,9 @@ struct Step {
     /// What the step adds to the frame as it will run (a creature going down still costs its
     /// level): kept, so that taking the step does not look at its creature again.
     running_us: f32,
+    /// Whether it stands for the steps of a group of quiet creatures (`creature` is the
+    /// group: [`QuietGroups`]), above each of them, until it reaches the front.
+    group: bool,
 }
 
 /// The order steps are taken in, greatest first: the most benefit per microsecond, then the
@@ -361,17 +371,26 @@ fn list_and_allocate<S: Send>(
     let dear_us = dear_us.unwrap_or_else(|| floors.dear_us(budget_us));
     let listed = hull.list(candidates, dear_us);
     let settled_now = candidates.iter().map(|c| c.settled).collect();
-    allocate_listed(candidates, floors, settled_now, listed, budget_us, hull, settle)
+    allocate_listed(
+        candidates,
+        floors,
+        settled_now,
+        (listed, QuietGroups::default()),
+        budget_us,
+        hull,
+        settle,
+    )
 }
 
 /// [`allocate`] from every creature at its floor (`floors`), whether each is `settled_now`, and
 /// the steps up their hulls `listed` ([`Hull::list`], its dear steps beyond the room in the
-/// budget the floors leave over [`DEAR_STEPS`]).
+/// budget the floors leave over [`DEAR_STEPS`]) but for the quiet creatures' `groups`, each
+/// opened, and charged, only when it reaches the front with room for a step of its own.
 fn allocate_listed<'a, S: Send>(
     crowd: &mut (impl Crowd<'a> + ?Sized),
     floors: Floors,
     mut settled_now: Vec<bool>,
-    listed: Listing,
+    (listed, groups): (Listing, QuietGroups),
     budget_us: f32,
     hull: &Hull,
     settle: impl Fn(usize) -> (f32, S) + Sync,
@@ -386,6 +405,9 @@ fn allocate_listed<'a, S: Send>(
     // The queue: the lists of steps, merged as it goes, best first.
     let threads = threads_for(levels.len() as u32);
     let mut lists: Vec<Queued<S>> = Vec::new();
+    let (open_us, group_needs) = (groups.open_us.clone(), groups.needs.clone());
+    let group_members = groups.members.clone();
+    let mut opened_creatures = 0;
     if spent + cheapest_us <= budget_us {
         lists.push(Queued::cheap(listed.cheap, hull, threads));
         lists.extend(
@@ -394,7 +416,12 @@ fn allocate_listed<'a, S: Send>(
                 .into_iter()
                 .map(|(_, dear)| Queued::dear(dear, hull, threads)),
         );
+        if !groups.steps.is_empty() {
+            lists.push(Queued::groups(groups, threads));
+        }
     }
+    // The steps of the groups opened, and what opening them cost.
+    let (mut opened, mut opening, mut opened_us) = (std::collections::BinaryHeap::new(), Vec::new(), 0.0);
     // The list last taken from, and the best next step of the others then: it is taken from
     // while its next step is above that.
     let mut run: Option<(usize, Option<Step>)> = None;
@@ -422,8 +449,10 @@ fn allocate_listed<'a, S: Send>(
                 let step = q.steps[q.next];
                 if !live(q, spent, running_us)
                     || step.bound
+                    || step.group
                     || others.is_some_and(|o| step <= o)
                     || follow.is_some_and(|f| f > step)
+                    || opened.peek().is_some_and(|o| *o > step)
                 {
                     break;
                 }
@@ -465,39 +494,75 @@ fn allocate_listed<'a, S: Send>(
         if let Some(q) = first.map(|i| &mut lists[i]) {
             q.sort_to(q.next + 1);
         }
-        let (step, list) = match (first, follows.heap.peek()) {
-            (Some(i), Some(follow)) if *follow > lists[i].steps[lists[i].next] => (follows.heap.pop(), None),
-            (Some(i), _) => {
-                let q = &mut lists[i];
-                q.next += 1;
-                (Some(q.steps[q.next - 1]), Some(i))
-            }
-            // Once none of them fits, the steps waiting in the heap are passed by too.
-            (None, _) if !rising || spent + follows.extra_us <= budget_us => (follows.heap.pop(), None),
-            (None, _) => (None, None),
-        };
-        let Some(step) = step else { break };
+        // The greatest of the lists' next step, the settled creatures' and the opened groups'
+        // (the list's among equals). Once no list's step fits, the settled creatures' steps
+        // are passed by too.
+        let follow = (follows.heap.peek().copied())
+            .filter(|_| first.is_some() || !rising || spent + follows.extra_us <= budget_us);
+        let listed = first.map(|i| (lists[i].steps[lists[i].next], Source::Listed(i)));
+        let best = [
+            listed,
+            follow.map(|f| (f, Source::Followed)),
+            opened.peek().map(|&o| (o, Source::Opened)),
+        ]
+        .into_iter()
+        .flatten()
+        .reduce(|a, b| if b.0 > a.0 { b } else { a });
+        let Some((step, source)) = best else { break };
+        match source {
+            Source::Listed(i) => lists[i].next += 1,
+            Source::Followed => _ = follows.heap.pop(),
+            Source::Opened => _ = opened.pop(),
+        }
         if spent + cheapest_us > budget_us {
             break;
         }
-        let followed = list.is_none();
+        if step.group {
+            // Its creatures' steps are all below it, so they are listed from here on as they
+            // would have been from the start. Once its room can never be had, they can change
+            // nothing (the list's `live` test, for this one).
+            let group = step.creature as usize;
+            let (any, exact) = group_needs[group];
+            // Its opening is paid at once and never given back, so it must fit beside the frame
+            // as it will run, as a search must.
+            let fits = spent + if searches_fit(running_us) { any } else { exact } <= budget_us
+                && (open_us[group] == 0.0 || running_us + open_us[group] <= budget_us);
+            if !rising || fits {
+                let mut steps = std::mem::take(&mut opening);
+                crowd.open(group, hull, &mut settled_now, &mut steps);
+                opened.extend(steps.drain(..));
+                opening = steps;
+                opened_creatures += group_members[group] as usize;
+                (spent, running_us, opened_us) = (
+                    spent + open_us[group],
+                    running_us + open_us[group],
+                    opened_us + open_us[group],
+                );
+            }
+            continue;
+        }
+        let followed = source == Source::Followed;
         debug_assert!(!(followed && step.bound), "a settled creature's steps are exact");
         let creature = step.creature as usize;
         // A step from a level the creature did not reach, or a bound since settled.
         if levels[creature] != step.from || (step.bound && settled_now[creature]) {
             continue;
         }
-        if let Some(i) = list.filter(|_| step.bound) {
+        if step.bound {
             // Worth settling only with room for the search and a step after it.
             if searches_fit(running_us) && spent + settle_us + step.extra_us <= budget_us {
                 // Bounds are listed only (a settled creature's steps are exact).
                 let room_us = budget_us - spent.max(running_us);
-                // Settled with the next bounds of its list, put in order that far.
-                let q = &mut lists[i];
-                let at = q.next - 1;
-                q.sort_to(at + 1 + q.ahead.batch);
-                let sorted = &q.steps[..q.sorted];
-                let now = q.ahead.take(at, sorted, &*crowd, &settled_now, hull, room_us, &settle);
+                let now = if let Source::Listed(i) = source {
+                    // Settled with the next bounds of its list, put in order that far.
+                    let q = &mut lists[i];
+                    let at = q.next - 1;
+                    q.sort_to(at + 1 + q.ahead.batch);
+                    let sorted = &q.steps[..q.sorted];
+                    q.ahead.take(at, sorted, &*crowd, &settled_now, hull, room_us, &settle)
+                } else {
+                    Settled::of(&step, &*crowd, hull, &settle)
+                };
                 spent += settle_us;
                 running_us += settle_us;
                 settled.push((creature, now.kept));
@@ -517,9 +582,9 @@ fn allocate_listed<'a, S: Send>(
             }
         }
     }
-    let searched_us = settled.len() as f32 * settle_us;
+    let choosing_us = settled.len() as f32 * settle_us + opened_us;
     let frame = |levels: &[Lod]| -> f32 {
-        searched_us
+        choosing_us
             + (floors.frame_at_us.iter().zip(levels))
                 .map(|(at, &l)| at[l as usize])
                 .sum::<f32>()
@@ -548,6 +613,7 @@ fn allocate_listed<'a, S: Send>(
         predicted_us,
         exceeded: predicted_us > budget_us,
         settled,
+        quiet: group_members.iter().sum::<u32>() as usize - opened_creatures,
     }
 }
 
@@ -592,7 +658,7 @@ impl Hull {
     fn list(&self, candidates: &[Candidate], dear_us: f32) -> Listing {
         let mut listed = Listing::new(dear_us, candidates.len());
         for (i, c) in (0..).zip(candidates) {
-            c.list_hull(i, self, &c.priced(self.hysteresis), &mut listed);
+            c.list_hull(i, self, &c.priced(self.hysteresis), |step| listed.push(step, self));
         }
         listed.finish();
         listed
@@ -768,6 +834,23 @@ impl<S: Send> Queued<S> {
         }
     }
 
+    /// The quiet creatures' groups, each a step above all of theirs ([`QuietGroups`]).
+    fn groups(groups: QuietGroups, threads: usize) -> Self {
+        let mut need_from = vec![(f32::INFINITY, f32::INFINITY); groups.steps.len() + 1];
+        for (i, step) in groups.steps.iter().enumerate().rev() {
+            let ((any, exact), need) = (need_from[i + 1], groups.needs[step.creature as usize]);
+            need_from[i] = (any.min(need.0), exact.min(need.1));
+        }
+        Self {
+            sorted: groups.steps.len(),
+            steps: groups.steps,
+            best: None,
+            next: 0,
+            need: Need::From(need_from),
+            ahead: SettledAhead::new(threads),
+        }
+    }
+
     /// The room its next step needs, and an exact one.
     fn needs(&self) -> (f32, f32) {
         match &self.need {
@@ -802,12 +885,40 @@ impl<S: Send> Queued<S> {
     }
 }
 
+/// Where the queue's next step comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Source {
+    /// One of its lists.
+    Listed(usize),
+    /// The steps of settled creatures ([`Follows`]).
+    Followed,
+    /// The steps of the groups of quiet creatures opened ([`QuietGroups`]).
+    Opened,
+}
+
 /// A bound settled: the exact benefit, what the caller keeps of the settling, and the
 /// creature's step from there.
 struct Settled<S> {
     benefit: f32,
     kept: S,
     step: Option<Step>,
+}
+
+impl<S> Settled<S> {
+    /// The bound `step` settled by `settle`, and its creature's next step.
+    fn of<'a>(
+        step: &Step,
+        crowd: &(impl Crowd<'a> + ?Sized),
+        hull: &Hull,
+        settle: &impl Fn(usize) -> (f32, S),
+    ) -> Self {
+        let (benefit, kept) = settle(step.creature as usize);
+        let mut c = crowd.candidate(step.creature as usize);
+        c.benefit[Lod::Rigid as usize] = benefit;
+        c.settled = true;
+        let step = c.step_from(step.creature, step.from, hull, &c.priced(hull.hysteresis));
+        Self { benefit, kept, step }
+    }
 }
 
 /// The bounds further down the queue, settled ahead across the cores: by their place in the
@@ -867,13 +978,7 @@ impl<S: Send> SettledAhead<S> {
             run_chunks(places.chunks(n).zip(made.chunks_mut(n)).map(|(places, made)| {
                 move || {
                     for (&i, m) in places.iter().zip(made) {
-                        let step = &listed[i];
-                        let (benefit, kept) = settle(step.creature as usize);
-                        let mut c = crowd.candidate(step.creature as usize);
-                        c.benefit[Lod::Rigid as usize] = benefit;
-                        c.settled = true;
-                        let step = c.step_from(step.creature, step.from, hull, &c.priced(hull.hysteresis));
-                        *m = Some(Settled { benefit, kept, step });
+                        *m = Some(Settled::of(&listed[i], crowd, hull, settle));
                     }
                 }
             }));
@@ -993,6 +1098,7 @@ impl Floors {
             exceeded: self.frame_us + overhead_us > budget_us,
             levels: self.levels,
             settled: Vec::new(),
+            quiet: 0,
         }
     }
 }
@@ -1093,6 +1199,8 @@ pub struct BudgetTally {
     pub predicted_max_us: f32,
     /// Creatures searched for contacts with others, over all decisions.
     pub searched: u64,
+    /// Creatures left quiet, their benefits not worked out, over all decisions.
+    pub quiet: u64,
     /// The percentile mode's last frames.
     pub recent: RecentFrames,
     /// Frames measured so far, each of which corrected the model (the adaptive mode).
@@ -1115,6 +1223,10 @@ pub struct BudgetSummary {
     /// Creatures searched for contacts with other creatures per decision, on average (the
     /// choice searches only those that could still buy a level).
     pub searched_per_decision: f64,
+    /// Creatures left quiet per decision, on average: out of view, at their floor, their
+    /// benefits never worked out (the incremental choice, where working out every creature
+    /// would cost more than the room it leaves).
+    pub quiet_per_decision: f64,
     /// Whether the adaptive mode corrected the cost model (the run is then not reproducible),
     /// and its last correction (measured over predicted; 1 when off).
     pub adaptive: bool,
@@ -1140,6 +1252,7 @@ impl Default for BudgetTally {
             predicted_sum_us: 0.0,
             predicted_max_us: 0.0,
             searched: 0,
+            quiet: 0,
             recent: RecentFrames::default(),
             frames_measured: 0,
         }
@@ -1214,6 +1327,7 @@ impl BudgetTally {
             decisions: self.decisions,
             decisions_over_budget: self.over_budget,
             searched_per_decision: self.searched as f64 / self.decisions.max(1) as f64,
+            quiet_per_decision: self.quiet as f64 / self.decisions.max(1) as f64,
             adaptive: rules.adaptive_frames > 0.0,
             correction: self.correction,
             adaptive_percentile: rules.adaptive_percentile,
@@ -1226,6 +1340,7 @@ impl BudgetTally {
         self.decisions += 1;
         self.over_budget += u64::from(a.exceeded);
         self.searched += a.settled.len() as u64;
+        self.quiet += a.quiet as u64;
         self.predicted_sum_us += f64::from(self.predicted_us());
         self.predicted_max_us = self.predicted_max_us.max(self.predicted_us());
     }
@@ -1293,6 +1408,8 @@ struct Scene<'a> {
     view_reach: Vec<ViewReach>,
     /// The fastest kind's top speed, for the earliest possible contacts.
     top_speed: f32,
+    /// The widest kind's footprint radius, m.
+    widest_m: f32,
     /// How far away another creature can still matter.
     reach_m: f32,
     /// The latest times at which the puck or an area, and a wall, can be worth as much as a
@@ -1431,6 +1548,245 @@ impl Scene<'_> {
             seen: hybrid + r.view_rigid_weight * view + followed,
             near: self.near(s, radius_m),
         }
+    }
+}
+
+impl Scene<'_> {
+    /// The court in tiles of about [`CREATURES_PER_TILE`] creatures of `creatures`, each tested
+    /// once against the view and the nearest contacts ([`Tiles`]).
+    fn tiles(&self, creatures: usize) -> Tiles {
+        let half = self.court.half_extents;
+        let tiles = (creatures / CREATURES_PER_TILE).max(1) as f32;
+        let tile_m = (4.0 * half.x * half.y / tiles).sqrt().max(SMALLEST_TILE_M);
+        let (cols, rows) = (
+            (2.0 * half.x / tile_m).ceil().max(1.0) as u32,
+            (2.0 * half.y / tile_m).ceil().max(1.0) as u32,
+        );
+        // A centimetre more on each side, for the rounding of a creature's place into its tile.
+        let slack = Vec2::splat(0.01);
+        // A creature may run a little over its kind's top speed (pushed, or rounding).
+        let fastest = self.top_speed.max(self.grid.fastest_and_widest().0);
+        let near = (0..rows)
+            .flat_map(|y| (0..cols).map(move |x| -half + tile_m * Vec2::new(x as f32, y as f32)))
+            .map(|lo| {
+                let (lo, hi) = (lo - slack, lo + Vec2::splat(tile_m) + slack);
+                let out_of_view = self
+                    .view_reach
+                    .iter()
+                    .all(|reach| self.camera.sees_none_within(reach, lo, hi));
+                if out_of_view {
+                    self.near_at_most(lo, hi, fastest)
+                } else {
+                    -1.0
+                }
+            })
+            .collect();
+        Tiles {
+            min: -half,
+            inv_tile_m: 1.0 / tile_m,
+            cols,
+            rows,
+            fastest_m_per_s: fastest,
+            near,
+        }
+    }
+
+    /// The most [`Scene::near_benefit`] can be for a creature no faster than `fastest_m_per_s`
+    /// on the ground in `lo..hi`: its contacts no sooner than the box's gaps allow, on its
+    /// course at that speed and at the earliest at its kind's.
+    fn near_at_most(&self, lo: Vec2, hi: Vec2, fastest_m_per_s: f32) -> f32 {
+        let margin = self.rules.contact_margin_m;
+        let mut puck = ContactTimes {
+            course_s: f32::INFINITY,
+            worst_s: f32::INFINITY,
+        };
+        for circle in &self.circles {
+            let a = &circle.area;
+            let gap = (a.position.distance(a.position.clamp(lo, hi)) - (self.widest_m + a.radius_m + margin)).max(0.0);
+            puck = puck.sooner(ContactTimes {
+                course_s: gap / (fastest_m_per_s + a.velocity.length()).max(1e-3),
+                worst_s: gap / circle.closing_m_per_s,
+            });
+        }
+        let room = self.court.half_extents - Vec2::splat(self.widest_m + margin) - lo.abs().max(hi.abs());
+        let gap = room.min_element().max(0.0);
+        let wall = ContactTimes {
+            course_s: gap / fastest_m_per_s.max(1e-3),
+            worst_s: gap / self.top_speed.max(1e-3),
+        };
+        self.near_benefit(&Near { puck, wall })
+    }
+}
+
+/// Creatures a tile of [`Tiles`] holds on average, in a crowd at the default game's density.
+const CREATURES_PER_TILE: usize = 32;
+
+/// The smallest tile, m.
+const SMALLEST_TILE_M: f32 = 4.0;
+
+/// The court in square tiles, each with whether any creature in it may be in view and the most
+/// its contacts with the puck, the host's areas and the walls can be worth: what a quiet
+/// creature's group is bounded by ([`QuietGroups`]).
+struct Tiles {
+    min: Vec2,
+    inv_tile_m: f32,
+    cols: u32,
+    rows: u32,
+    /// The fastest speed the tiles' bounds hold for: a faster creature is never quiet.
+    fastest_m_per_s: f32,
+    /// By tile, row by row: [`Scene::near_at_most`], negative where a creature may be in view.
+    near: Vec<f32>,
+}
+
+impl Tiles {
+    /// The most a creature at `s` out of view can gain from the puck, the areas and the walls;
+    /// none if it may be in view (or is faster than any kind, or off the court).
+    fn quiet_near(&self, s: &PlanarState) -> Option<f32> {
+        if s.velocity.length_squared() > self.fastest_m_per_s * self.fastest_m_per_s {
+            return None;
+        }
+        let at = (s.position - self.min) * self.inv_tile_m;
+        if !(at.x >= 0.0 && at.y >= 0.0) {
+            return None;
+        }
+        let (x, y) = (at.x as u32, at.y as u32);
+        if x >= self.cols || y >= self.rows {
+            return None;
+        }
+        Some(self.near[(y * self.cols + x) as usize]).filter(|&near| near >= 0.0)
+    }
+}
+
+/// Rows of a decision in a group of quiet creatures ([`QuietGroups`]): a bit of a `u64` each.
+const GROUP_ROWS: usize = 64;
+
+/// What a group's quiet creatures' steps can be, gathered row by row: their one step each (out
+/// of view, at their floor, a quiet creature can only go rigid, for contacts). A group's rows
+/// are in two: those whose step is a bound to be settled by a search (group `2 g`), and those
+/// whose step may be exact (`2 g + 1`: a search standing, or the puck or a wall outweighing any
+/// other creature), so that where no search fits, only the second is opened.
+#[derive(Clone, Copy, Debug)]
+struct QuietGroup {
+    /// Its creatures with a step, a bit a row.
+    members: u64,
+    /// The most benefit per microsecond any of their steps can have, and the lowest serial.
+    ratio: f32,
+    serial: u32,
+    /// The least room any of their steps needs.
+    need_us: f32,
+}
+
+impl Default for QuietGroup {
+    fn default() -> Self {
+        Self {
+            members: 0,
+            ratio: 0.0,
+            serial: u32::MAX,
+            need_us: f32::INFINITY,
+        }
+    }
+}
+
+impl QuietGroup {
+    fn add(&mut self, row: usize, ratio: f32, serial: u32, need_us: f32) {
+        self.members |= 1 << (row % GROUP_ROWS);
+        self.ratio = self.ratio.max(ratio);
+        self.serial = self.serial.min(serial);
+        self.need_us = self.need_us.min(need_us);
+    }
+
+    /// A quiet creature's one step, to rigid, into its group's two (`pair`): worth at most
+    /// `rigid_at_most`, adding `extra_us`, and a bound to be settled unless `may_be_exact`.
+    fn gather(
+        pair: &mut [QuietGroup],
+        (row, serial): (usize, u32),
+        rigid_at_most: f32,
+        extra_us: f32,
+        may_be_exact: bool,
+        hull: &Hull,
+    ) {
+        if rigid_at_most <= 0.0 {
+            return;
+        }
+        let ratio = if extra_us > 0.0 {
+            rigid_at_most / extra_us
+        } else {
+            f32::INFINITY
+        };
+        if ratio >= hull.least_per_us {
+            let need_us = if may_be_exact {
+                extra_us
+            } else {
+                hull.settle_us + extra_us
+            };
+            pair[usize::from(may_be_exact)].add(row, ratio, serial, need_us);
+        }
+    }
+
+    /// Group `group`'s creatures' steps up their hulls into `opened`, each marked in
+    /// `settled_now` as it is.
+    fn open<'a>(
+        group: usize,
+        members: u64,
+        crowd: &(impl Crowd<'a> + ?Sized),
+        hull: &Hull,
+        settled_now: &mut [bool],
+        opened: &mut Vec<Step>,
+    ) {
+        let mut members = members;
+        while members != 0 {
+            let i = group / 2 * GROUP_ROWS + members.trailing_zeros() as usize;
+            members &= members - 1;
+            let c = crowd.candidate(i);
+            settled_now[i] = c.settled;
+            c.list_hull(i as u32, hull, &c.priced(hull.hysteresis), |step| opened.push(step));
+        }
+    }
+}
+
+/// The quiet creatures of a decision (out of view in a tile the view cone misses, at the level
+/// last chosen and their floor, not followed) by groups of [`GROUP_ROWS`] rows, each group one
+/// step above all of theirs: their benefits are worked out only for a group that reaches the
+/// front of the queue with room for a step of its own, and that costs the budget what it saves
+/// (Funkhouser & Sequin's incremental choice, taken to crowds).
+#[derive(Default)]
+struct QuietGroups {
+    /// A step for each group with members, sorted.
+    steps: Vec<Step>,
+    /// By group: the room its steps need, any and an exact one, its opening beside.
+    needs: Vec<(f32, f32)>,
+    /// By group: what working out its creatures costs, and how many there are.
+    open_us: Vec<f32>,
+    members: Vec<u32>,
+}
+
+impl QuietGroups {
+    /// The groups gathered, a creature's working out at `evaluate_us`.
+    fn of(groups: &[QuietGroup], evaluate_us: f32) -> Self {
+        let mut all = Self::default();
+        for (g, q) in (0..).zip(groups) {
+            let open = evaluate_us * q.members.count_ones() as f32;
+            let exact_us = if g % 2 == 1 { q.need_us } else { f32::INFINITY };
+            all.needs.push((open + q.need_us, open + exact_us));
+            all.open_us.push(open);
+            all.members.push(q.members.count_ones());
+            if q.members != 0 {
+                all.steps.push(Step {
+                    ratio: q.ratio,
+                    bound: false,
+                    serial: q.serial,
+                    creature: g,
+                    // Below any creature's step up, so above it among equals.
+                    from: Lod::PointMass,
+                    to: Lod::PointMass,
+                    extra_us: open + q.need_us,
+                    running_us: 0.0,
+                    group: true,
+                });
+            }
+        }
+        Step::sort(&mut all.steps);
+        all
     }
 }
 
@@ -1609,8 +1965,17 @@ fn decide(
             floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
         }
     }
-    // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget first.
-    let room_us = budget_us - config.costs.overhead_us(floors.levels.len());
+    // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget
+    // first: a quiet creature's working out only if its group is opened (below). Quiet creatures are
+    // left to their groups only where working out every creature costs more than the room
+    // that leaves, and the pass over them leaves room for a step: where the budget affords
+    // every creature, all listed at once cost less than their groups opened one by one (at
+    // 100,000 creatures with room for every step, 6 ms against 40).
+    let (evaluate_us, overhead_us) = (config.costs.evaluation_us(count), config.costs.overhead_us(count));
+    let incremental = config.rules.budget.incremental_choice
+        && count as f32 * evaluate_us > budget_us - overhead_us - floors.cost_us
+        && floors.any_step_fits(budget_us - config.costs.floors_only_overhead_us(count));
+    let room_us = budget_us - overhead_us;
     // Where not one step up fits, the benefits are not worked out, nor the creatures listed,
     // and the choice costs the pass over them above (a crowd far over its budget), charged as
     // such. A creature at its kind's dearest level goes to its floor; the others keep their
@@ -1619,7 +1984,7 @@ fn decide(
     // their floors at once (40,000 creatures at 10 ms in the adaptive mode, 2026-11-27) made
     // frames of 181, 51 and 37 ms, and the correction that followed held the crowd at its
     // floors.
-    if !floors.any_step_fits(room_us) {
+    if !incremental && !floors.any_step_fits(room_us) {
         let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
         let dearest: Vec<Option<Lod>> = kinds.0.iter().map(|k| k.levels.iter().copied().max()).collect();
         let current_and_dearest =
@@ -1640,13 +2005,17 @@ fn decide(
     let bounds_of = |(entity, c, _, s, _): Row| scene.bounds(entity, s, c.kind, kinds[c.kind].radius_m);
     // A creature as the knapsack sees it: made where its bounds are worked out, and again only
     // for the few the queue comes back to.
-    let made = |row: Row, floor: Lod| {
+    // In the incremental choice, ties go to the creature first in the query (its place is its
+    // serial here): a group of quiet creatures is a run of places, so that among a crowd's equal
+    // bounds the queue reaches a group's creatures together, not one from each group in turn.
+    // Working out every creature, they go to the lower serial, as they always did.
+    let made = |row: Row, floor: Lod, place: usize| {
         let ((_, c, &lod, _, choice), bound) = (row, bounds_of(row));
         // A search within `contact_recheck_s` stands; without one, any contact with another
         // creature could be now.
         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
         Candidate {
-            serial: c.serial,
+            serial: if incremental { place as u32 } else { c.serial },
             current: lod,
             last: choice.wanted,
             floor,
@@ -1660,20 +2029,70 @@ fn decide(
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
     // the cores a block at a time in turn: what one costs here depends on where it is (in view
     // or not), and the query keeps neighbours together, so that halves of it would not balance.
+    // What a quiet creature's step to rigid adds, by kind and floor (at its floor, it switches
+    // from there): none where its kind has no rigid level above the floor.
+    let rigid_extra_us: Vec<[Option<f32>; 3]> = (kinds.0.iter().zip(&costs))
+        .map(|(kind, &costs)| {
+            Lod::ALL.map(|floor| {
+                let c = Candidate {
+                    serial: 0,
+                    current: floor,
+                    last: floor,
+                    floor,
+                    levels: &kind.levels,
+                    costs,
+                    benefit: [0.0; 3],
+                    settled: true,
+                };
+                let p = c.priced(0.0);
+                (floor < Lod::Rigid && kind.levels.contains(&Lod::Rigid))
+                    .then(|| p.cost_us[Lod::Rigid as usize] - p.cost_us[floor as usize])
+            })
+        })
+        .collect();
+    // A quiet creature's one step, gathered into its group: at most the tile's contacts with the
+    // puck, the areas and the walls, or the contacts with other creatures its search stands at
+    // (or could be, without one), over what it adds.
+    let quiet_step = |(_, c, _, _, choice): Row, floor: Lod, near: f32, row: usize, group: &mut [QuietGroup]| {
+        let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
+        let rigid_at_most = near.max(rules.creature_weight * standing.map_or(1.0, |s| s.0));
+        if let Some(extra_us) = rigid_extra_us[c.kind][floor as usize] {
+            let may_be_exact = standing.is_some() || near >= rules.creature_weight;
+            QuietGroup::gather(group, (row, row as u32), rigid_at_most, extra_us, may_be_exact, &hull);
+        }
+    };
+    // Where a creature is quiet, the most its contacts with the puck, the areas and the walls
+    // can be worth.
+    let (tiles, following) = (incremental.then(|| scene.tiles(count)), scene.camera.following);
+    let quiet_near = |(entity, _, &lod, s, choice): Row, floor: Lod| {
+        let tiles = tiles.as_ref()?;
+        (lod == floor && choice.wanted == floor && following != Some(entity)).then(|| tiles.quiet_near(s))?
+    };
     let mut settled_now = vec![false; count];
+    let mut groups = vec![QuietGroup::default(); 2 * count.div_ceil(GROUP_ROWS)];
     let threads = count.div_ceil(chunk_len(config.scenario.creature_count(), count));
-    let dear_us = floors.dear_us(room_us);
+    // Dear beside the room the floors leave, as though every creature were quiet.
+    let dear_us = floors.dear_us(if incremental {
+        budget_us - config.costs.floors_only_overhead_us(count)
+    } else {
+        room_us
+    });
     let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
-    let blocks = (floors.levels.chunks(DEALT_BLOCK)).zip(settled_now.chunks_mut(DEALT_BLOCK));
+    let blocks = (floors.levels.chunks(DEALT_BLOCK)).zip(
+        settled_now
+            .chunks_mut(DEALT_BLOCK)
+            .zip(groups.chunks_mut(2 * DEALT_BLOCK / GROUP_ROWS)),
+    );
     for (b, block) in blocks.enumerate() {
         dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
     }
-    let mut chunks: Vec<Option<Listing>> = (0..threads).map(|_| None).collect();
+    let mut chunks: Vec<Option<(Listing, usize)>> = (0..threads).map(|_| None).collect();
     run_chunks(dealt.into_iter().zip(chunks.iter_mut()).map(|(blocks, listed)| {
-        let (hull, made, tables) = (&hull, &made, &tables);
+        let (hull, made, quiet_near, quiet_step, tables) = (&hull, &made, &quiet_near, &quiet_step, &tables);
         move || {
             let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, (floors, _))| floors.len()).sum());
-            for (first, (mut floors, mut settled_now)) in blocks {
+            let mut quiet = 0;
+            for (first, (mut floors, (mut settled_now, groups))) in blocks {
                 let mut i = first;
                 // A table's part at a time: its slices side by side with the block's.
                 for (entity, c, lod, s, choice) in tables.parts(first as usize, first as usize + floors.len()) {
@@ -1685,31 +2104,48 @@ fn decide(
                     for ((((&entity, c), lod), (s, choice)), (&floor, settled)) in
                         rows.zip(floors_here.iter().zip(settled_here))
                     {
-                        let candidate = made((entity, c, lod, s, choice), floor);
-                        *settled = candidate.settled;
-                        candidate.list_hull(i, hull, &candidate.priced(hull.hysteresis), &mut listing);
+                        let (row, at) = ((entity, c, lod, s, choice), (i - first) as usize);
+                        if let Some(near) = quiet_near(row, floor) {
+                            let group = 2 * (at / GROUP_ROWS);
+                            quiet_step(row, floor, near, i as usize, &mut groups[group..group + 2]);
+                            quiet += 1;
+                        } else {
+                            let candidate = made(row, floor, i as usize);
+                            *settled = candidate.settled;
+                            let p = candidate.priced(hull.hysteresis);
+                            candidate.list_hull(i, hull, &p, |step| listing.push(step, hull));
+                        }
                         i += 1;
                     }
                 }
             }
             listing.finish();
-            *listed = Some(listing);
+            *listed = Some((listing, quiet));
         }
     }));
-    let listed = Listing::merge(chunks.into_iter().flatten().collect());
+    let (listed, quiet): (Vec<_>, Vec<_>) = chunks.into_iter().flatten().unzip();
+    let quiet_count = quiet.iter().sum::<usize>();
+    let (listed, quiet) = (Listing::merge(listed), quiet_count as f32);
+    // A quiet creature's working out is paid for only if its group is opened.
+    let room_us = room_us + quiet * evaluate_us;
     let floor_levels = floors.levels.clone();
     let mut crowd = Gathered {
-        made: |i: usize| made(tables.row(i), floor_levels[i]),
+        made: |i: usize| made(tables.row(i), floor_levels[i], i),
         settled: Default::default(),
+        members: groups.iter().map(|g| g.members).collect(),
     };
+    let groups = QuietGroups::of(&groups, evaluate_us);
+    // Quiet creatures with no step up are in no group.
+    let stepless = quiet_count - groups.members.iter().sum::<u32>() as usize;
     // Only a creature that could still buy a level is searched for contacts with the others.
-    let mut allocation = allocate_listed(&mut crowd, floors, settled_now, listed, room_us, &hull, |i| {
+    let mut allocation = allocate_listed(&mut crowd, floors, settled_now, (listed, groups), room_us, &hull, |i| {
         let row @ (_, c, _, s, _) = tables.row(i);
         let urgency = scene.crowding(c, s, kinds[c.kind].radius_m);
         (bounds_of(row).rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
-    allocation.predicted_us += config.costs.overhead_us(count);
+    allocation.predicted_us += overhead_us - quiet * evaluate_us;
+    allocation.quiet += stepless;
     allocation
 }
 
@@ -1789,6 +2225,8 @@ impl<'w> Tables<'w> {
 struct Gathered<F> {
     made: F,
     settled: std::collections::HashMap<usize, f32>,
+    /// By group of quiet creatures, its members ([`QuietGroup::members`]).
+    members: Vec<u64>,
 }
 
 impl<'a, F: Fn(usize) -> Candidate<'a> + Sync> Crowd<'a> for Gathered<F> {
@@ -1803,6 +2241,10 @@ impl<'a, F: Fn(usize) -> Candidate<'a> + Sync> Crowd<'a> for Gathered<F> {
 
     fn settle(&mut self, i: usize, rigid_benefit: f32) {
         self.settled.insert(i, rigid_benefit);
+    }
+
+    fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut Vec<Step>) {
+        QuietGroup::open(group, self.members[group], self, hull, settled_now, opened);
     }
 }
 
@@ -1826,6 +2268,7 @@ fn scene<'a>(
         camera,
         view_reach: kinds.0.iter().map(|k| camera.view_reach(k, 0.0)).collect(),
         top_speed,
+        widest_m: biggest,
         // Beyond three horizons at both creatures' top speeds, a contact is worth under 5 %.
         reach_m: 2.0 * biggest + rules.contact_margin_m + 2.0 * top_speed * 3.0 * rules.contact_horizon_s,
         outweigh_creature_s: (
@@ -1902,7 +2345,8 @@ fn start_by_budget(
         return;
     }
     let now = inputs.clock.seconds() as f32;
-    let decision = inputs.decide(&creatures, tally.model_budget_us(&inputs.config.rules.budget), true);
+    let budget_us = tally.model_budget_us(&inputs.config.rules.budget);
+    let decision = inputs.decide(&creatures, budget_us, true);
     let mut searched = decision.settled.iter().peekable();
     for (row, ((entity, c, &lod, _, mut choice), &level)) in creatures.iter_mut().zip(&decision.levels).enumerate() {
         if level != lod
@@ -2133,6 +2577,107 @@ mod tests {
         }
     }
 
+    /// A crowd whose quiet creatures wait in groups, as a decision's do: how many were opened.
+    struct Grouped<'a> {
+        crowd: Vec<Candidate<'a>>,
+        members: Vec<u64>,
+        opened: std::sync::atomic::AtomicUsize,
+    }
+
+    impl<'a> Crowd<'a> for Grouped<'a> {
+        fn candidate(&self, i: usize) -> Candidate<'a> {
+            self.crowd[i].clone()
+        }
+
+        fn settle(&mut self, i: usize, rigid_benefit: f32) {
+            self.crowd[..].settle(i, rigid_benefit);
+        }
+
+        fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut Vec<Step>) {
+            let members = self.members[group].count_ones() as usize;
+            self.opened.fetch_add(members, std::sync::atomic::Ordering::Relaxed);
+            QuietGroup::open(group, self.members[group], self, hull, settled_now, opened);
+        }
+    }
+
+    #[test]
+    fn quiet_creatures_left_to_their_groups_are_chosen_as_if_every_one_were_listed() {
+        let (mut crowd, mut exact) = mixed_crowd(3000);
+        // Two in three quiet: out of view (no hybrid benefit), at their floor and last level;
+        // one in five of those with a search standing (exact).
+        let quiet: Vec<bool> = (0..crowd.len()).map(|i| i % 3 != 0).collect();
+        // Each creature's serial its place, as in a decision's incremental choice.
+        crowd.iter_mut().enumerate().for_each(|(i, c)| c.serial = i as u32);
+        for (i, c) in crowd.iter_mut().enumerate().filter(|(i, _)| quiet[*i]) {
+            exact[i] -= c.benefit[1];
+            (c.current, c.last, c.floor, c.benefit) = (Lod::PointMass, Lod::PointMass, Lod::PointMass, [0.0, 0.0, 2.0]);
+            if i % 5 == 0 {
+                (c.benefit[2], c.settled) = (exact[i], true);
+            }
+        }
+        for (room_us, settle_us, least_per_us) in [
+            (300.0, 0.0, 0.0),
+            (300.0, 3.0, 0.0),
+            (3000.0, 3.0, 0.0),
+            (1e6, 3.0, 0.002),
+        ] {
+            let hull = Hull {
+                hysteresis: 0.2,
+                least_per_us,
+                settle_us,
+            };
+            let mut floors = Floors::with_capacity(crowd.len());
+            crowd.iter().for_each(|c| floors.add(c.into()));
+            let budget_us = floors.cost_us + room_us;
+            let whole = list_and_allocate(&mut crowd.clone(), budget_us, &hull, None, |i| (exact[i], i));
+            // The others listed; the quiet ones gathered into their groups.
+            let mut listing = Listing::new(floors.dear_us(budget_us), crowd.len());
+            let mut groups = vec![QuietGroup::default(); 2 * crowd.len().div_ceil(GROUP_ROWS)];
+            for (i, c) in crowd.iter().enumerate() {
+                let p = c.priced(hull.hysteresis);
+                if quiet[i] {
+                    let extra_us = p.cost_us[Lod::Rigid as usize] - p.cost_us[Lod::PointMass as usize];
+                    let pair = &mut groups[2 * (i / GROUP_ROWS)..][..2];
+                    QuietGroup::gather(pair, (i, c.serial), c.benefit[2], extra_us, c.settled, &hull);
+                } else {
+                    c.list_hull(i as u32, &hull, &p, |step| listing.push(step, &hull));
+                }
+            }
+            listing.finish();
+            let members: usize = groups.iter().map(|g| g.members.count_ones() as usize).sum();
+            let mut grouped = Grouped {
+                members: groups.iter().map(|g| g.members).collect(),
+                crowd: crowd.clone(),
+                opened: Default::default(),
+            };
+            let settled_now = crowd.iter().zip(&quiet).map(|(c, &q)| c.settled && !q).collect();
+            let groups = QuietGroups::of(&groups, 0.0);
+            let lazy = allocate_listed(
+                &mut grouped,
+                floors,
+                settled_now,
+                (listing, groups),
+                budget_us,
+                &hull,
+                |i| (exact[i], i),
+            );
+            assert_eq!(
+                Allocation {
+                    quiet: 0,
+                    ..lazy.clone()
+                },
+                whole,
+                "{room_us} us, searches {settle_us} us"
+            );
+            let opened = grouped.opened.into_inner();
+            assert_eq!(lazy.quiet, members - opened);
+            // With room for a few steps, few of the quiet creatures are worked out.
+            if room_us < 1000.0 {
+                assert!(opened < 500, "{opened} opened of 2,000");
+            }
+        }
+    }
+
     #[test]
     fn settling_ahead_across_the_cores_chooses_as_settling_one_at_a_time() {
         bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
@@ -2314,9 +2859,47 @@ mod tests {
             camera,
             view_reach: Vec::new(),
             top_speed: 3.0,
+            widest_m: 0.6,
             reach_m,
             outweigh_creature_s: (outweigh_times_s(b, b.puck_weight), outweigh_times_s(b, b.wall_weight)),
         }
+    }
+
+    #[test]
+    fn a_tiles_bound_on_the_puck_and_the_walls_is_never_below_a_creatures_benefit_in_it() {
+        let rules: LevelRules = ron::from_str(include_str!("../../assets/rules/levels.ron")).unwrap();
+        let b = &rules.budget;
+        let puck = PuckState {
+            position: Vec2::new(10.0, -5.0),
+            velocity: Vec2::new(-4.0, 3.0),
+            radius_m: 2.0,
+        };
+        let court = Court {
+            half_extents: Vec2::new(60.0, 40.0),
+        };
+        let (grid, camera) = (NeighbourGrid::default(), SimCamera::default());
+        let scene = test_scene(b, &puck, &court, &grid, &camera, 30.0);
+        let mut next = uniform(77);
+        let (tile, mut least, mut largest) = (8.0, f32::INFINITY, 0.0f32);
+        for y in -5..5 {
+            for x in -7..7 {
+                let lo = Vec2::new(x as f32, y as f32) * tile;
+                let hi = lo + Vec2::splat(tile);
+                let most = scene.near_at_most(lo, hi, 3.0);
+                for _ in 0..200 {
+                    let s = PlanarState {
+                        position: lo + Vec2::new(next(), next()) * tile,
+                        velocity: Vec2::from_angle(next() * 6.3) * 3.0 * next(),
+                        heading: Vec2::X,
+                    };
+                    let benefit = scene.near_benefit(&scene.near(&s, 0.2 + 0.4 * next()));
+                    assert!(benefit <= most, "{benefit} over {most} in the tile at {lo}");
+                }
+                (least, largest) = (least.min(most), largest.max(most));
+            }
+        }
+        // At the puck the bound is a contact now; in the middle of the court, far less.
+        assert!(largest == 1.0 && least < 0.25, "{least} to {largest}");
     }
 
     #[test]
@@ -2456,6 +3039,7 @@ mod tests {
                         to: Lod::Rigid,
                         extra_us: 1.0,
                         running_us: 1.0,
+                        group: false,
                     }
                 })
                 .collect();

@@ -162,6 +162,25 @@ impl SimCamera {
         self.sees(position.extend(reach.height_m).xzy(), reach.radius_m + moved)
     }
 
+    /// Whether [`SimCamera::sees_within`] is false for every creature of `reach` on the ground
+    /// in `min..max`: the box at the reach's height, grown by it at the box's farthest ground
+    /// distance, lies wholly behind one of the frustum's planes. The view cone tested once for
+    /// a tile of the court, not once for each creature in it.
+    pub fn sees_none_within(&self, reach: &ViewReach, min: Vec2, max: Vec2) -> bool {
+        let corners =
+            [min, Vec2::new(min.x, max.y), Vec2::new(max.x, min.y), max].map(|c| c.extend(reach.height_m).xzy());
+        let farthest = corners.iter().map(|c| self.ground_distance(c.xz())).fold(0.0, f32::max);
+        // A millimetre a metre more, so that rounding never parts it from the creature's test.
+        let radius = reach.radius_m + reach.hop_m + farthest * reach.sweep + 1e-3 * (1.0 + farthest);
+        self.frustum.iter().any(|h| {
+            let nearest = corners
+                .iter()
+                .map(|&c| h.truncate().dot(c))
+                .fold(f32::NEG_INFINITY, f32::max);
+            nearest + h.w + radius < 0.0
+        })
+    }
+
     /// Distance on the ground from the eye.
     pub fn ground_distance(&self, q: Vec2) -> f32 {
         self.eye.xz().distance(q)
@@ -531,6 +550,53 @@ pub(super) fn plugin(app: &mut App) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tile_the_view_cone_misses_holds_no_creature_the_camera_could_see() {
+        let mut camera = SimCamera::looking_at(
+            Vec3::new(-20.0, 5.5, 3.0),
+            Vec3::new(10.0, -1.5, -4.0),
+            (60f32.to_radians(), 1.78, 300.0),
+            None,
+        );
+        camera.turn_rate_rad_per_s = 0.3;
+        let reach = ViewReach {
+            height_m: 0.6,
+            radius_m: 0.8,
+            hop_m: 1.2,
+            sweep: 0.15f32.sin(),
+        };
+        let mut seed = 12345u64;
+        let mut next = move || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (tile, mut missed, mut seen) = (8.0, 0, 0);
+        for y in -30..30 {
+            for x in -30..30 {
+                let min = Vec2::new(x as f32, y as f32) * tile;
+                let max = min + Vec2::splat(tile);
+                // Its corners and edges, and within.
+                let points: Vec<Vec2> = (0..64)
+                    .map(|i| match i {
+                        0..4 => Vec2::new([min.x, max.x][i & 1], [min.y, max.y][i >> 1]),
+                        _ => min + Vec2::new(next(), next()) * tile,
+                    })
+                    .collect();
+                let any_seen = points
+                    .iter()
+                    .any(|&p| camera.sees_within(&reach, p, camera.ground_distance(p)));
+                if camera.sees_none_within(&reach, min, max) {
+                    assert!(!any_seen, "a creature in view in the tile at {min}");
+                    missed += 1;
+                } else {
+                    seen += usize::from(any_seen);
+                }
+            }
+        }
+        // Most of the court lies behind the eye or beside the view, and the view holds tiles.
+        assert!(missed > 3600 / 2 && seen > 100, "{missed} missed, {seen} seen");
+    }
 
     #[test]
     fn a_creature_in_view_stays_in_view_until_it_is_the_margin_outside_the_frustum() {

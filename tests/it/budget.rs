@@ -656,3 +656,52 @@ fn a_hybrid_whose_switch_down_costs_more_than_it_saves_is_kept_hybrid_as_the_vie
         "{priced:?} against {free:?}"
     );
 }
+
+#[test]
+fn in_a_crowd_at_a_tight_budget_the_quiet_creatures_are_left_unworked_and_their_cost_buys_levels() {
+    // 3,000 hoppers at the default game's density, weighed by their contacts alone; working out
+    // a creature costs 0.9 us beyond the pass over it, 2.7 ms for the crowd, more than the
+    // 0.5 ms the full choice leaves beside the floors (3 ms) and its own cost (3 ms).
+    let run = |incremental: bool| {
+        let mut config = budget_scene(3000, 6.5);
+        let grow = (3000.0f32 / 40.0).sqrt();
+        (config.arena.court_length_m, config.arena.court_width_m) =
+            (config.arena.court_length_m * grow, config.arena.court_width_m * grow);
+        let costs = &mut config.costs;
+        (
+            costs.decision_us_per_creature,
+            costs.floors_only_us_per_creature,
+            costs.contact_search_us,
+        ) = (1.0, 0.1, 2.0);
+        // The camera sees 100 m deep: most of the court is out of view.
+        config.rules.camera.far_m = 100.0;
+        let budget = &mut config.rules.budget;
+        (
+            budget.view_hybrid_weight,
+            budget.view_rigid_weight,
+            budget.incremental_choice,
+        ) = (0.0, 0.0, incremental);
+        let mut sim = HeadlessSim::new(config);
+        sim.run_for(3.0);
+        (sim.state_digest(), sim.summary(0.0).without_wall_clock())
+    };
+    let (incremental, every_creature) = (run(true), run(false));
+    let (quiet, whole) = (
+        incremental.1.budget.clone().unwrap(),
+        every_creature.1.budget.clone().unwrap(),
+    );
+    // Most of the court is out of view: most of the crowd is never worked out.
+    assert!(quiet.quiet_per_decision > 1000.0, "{quiet:?}");
+    assert_eq!(whole.quiet_per_decision, 0.0);
+    // Within the budget; where the room it saves shrinks (fewer quiet), the creatures it
+    // bought still run their levels until their flight windows.
+    for b in [&quiet, &whole] {
+        assert!(b.predicted_ms_max <= 6.5 * 1.01, "{b:?}");
+    }
+    // What it saves buys rigid creatures the full choice had no room for.
+    let rigid = |s: &simlod::outcome::Summary| s.levels_mean[Lod::Rigid];
+    let (more, fewer) = (rigid(&incremental.1), rigid(&every_creature.1));
+    assert!(more > fewer + 1.5, "{more} against {fewer}: {quiet:?}");
+    // The same files give the same run.
+    assert_eq!(run(true), incremental);
+}

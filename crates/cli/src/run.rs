@@ -270,11 +270,12 @@ pub(crate) fn print_summary(args: &RunArgs, s: &Summary, config: &SimConfig, ran
             }
         };
         println!(
-            "frame budget {} ms of simulation per 1/30 s: as the policy chose, predicted {:.3} ms on average and {:.3} ms at most, {chosen}{adaptive}; {:.1} creatures searched for contacts a decision; measured {mean_ms:.3} ms of wall time on average, {}, and {p99_ms:.3} ms at the 99th percentile, {}",
+            "frame budget {} ms of simulation per 1/30 s: as the policy chose, predicted {:.3} ms on average and {:.3} ms at most, {chosen}{adaptive}; {:.1} creatures searched for contacts a decision, {:.0} left quiet; measured {mean_ms:.3} ms of wall time on average, {}, and {p99_ms:.3} ms at the 99th percentile, {}",
             b.frame_budget_ms,
             b.predicted_ms_mean,
             b.predicted_ms_max,
             b.searched_per_decision,
+            b.quiet_per_decision,
             against(mean_ms),
             against(p99_ms)
         );

@@ -125,34 +125,40 @@ pub struct ChoiceBench {
 }
 
 /// The budget policy's choice in the scenario's mix of `creatures`, after `warmup` frames of
-/// play under `budget_ms` (the scenario's rules and cost model): timed `choices` times at that
-/// moment (`choice_now`, not applied, so each is the same choice): as it plays there, its
-/// searches those whose last search no longer stands; and with room for every step and no
-/// searches (each creature's bounds, steps and the knapsack over them all: what
-/// `--calibrate` times).
+/// play under each of `budgets_ms` (the scenario's rules and cost model): timed `choices` times
+/// at that moment (`choice_now`, not applied, so each is the same choice) as it plays there, its
+/// searches those whose last search no longer stands (at a tight budget, the quiet creatures
+/// left to their groups); and after the last, with room for every step and no searches (each
+/// creature's bounds, steps and the knapsack over them all: what `--calibrate` times).
 fn choice_bench(
     config: &SimConfig,
     creatures: u32,
-    budget_ms: f32,
+    budgets_ms: &[f32],
     (warmup, choices): (usize, usize),
-) -> [ChoiceBench; 2] {
-    let mut game = scaled(config, creatures, LevelPolicy::Budget);
-    (game.rules.budget.frame_budget_ms, game.rules.budget.adaptive_frames) = (budget_ms, 0.0);
-    let mut sim = HeadlessSim::new(game);
-    play_on(&mut sim, warmup);
+) -> Vec<ChoiceBench> {
     let weight = config.rules.budget.creature_weight;
-    [(Some(budget_ms), weight), (None, 0.0)].map(|(frame_budget_ms, creature_weight)| {
-        let budget_ms = frame_budget_ms.unwrap_or(f32::MAX);
-        let (us, searched) = timed_choice(&mut sim, budget_ms, creature_weight, choices);
-        ChoiceBench {
-            creatures,
-            frame_budget_ms,
-            searches: creature_weight > 0.0,
-            us_per_creature_per_frame: us / f64::from(creatures.max(1)),
-            searched,
-            choices,
+    let mut benches = Vec::new();
+    for (i, &budget_ms) in budgets_ms.iter().enumerate() {
+        let mut game = scaled(config, creatures, LevelPolicy::Budget);
+        (game.rules.budget.frame_budget_ms, game.rules.budget.adaptive_frames) = (budget_ms, 0.0);
+        let mut sim = HeadlessSim::new(game);
+        play_on(&mut sim, warmup);
+        let last = i + 1 == budgets_ms.len();
+        let timings = std::iter::once((Some(budget_ms), weight)).chain(last.then_some((None, 0.0)));
+        for (frame_budget_ms, creature_weight) in timings {
+            let budget_ms = frame_budget_ms.unwrap_or(f32::MAX);
+            let (us, searched) = timed_choice(&mut sim, budget_ms, creature_weight, choices);
+            benches.push(ChoiceBench {
+                creatures,
+                frame_budget_ms,
+                searches: creature_weight > 0.0,
+                us_per_creature_per_frame: us / f64::from(creatures.max(1)),
+                searched,
+                choices,
+            });
         }
-    })
+    }
+    benches
 }
 
 /// How hard one level is measured.
@@ -304,11 +310,11 @@ pub fn run(config: &SimConfig, quick: bool, json: bool, only: Option<Lod>) {
     }
 }
 
-/// Times the budget policy's choice among 100,000 creatures (a fifth `quick`) and prints it
-/// (see `choice_bench`).
+/// Times the budget policy's choice among 100,000 creatures (a fifth `quick`) at 10 and 30 ms
+/// and prints it (see `choice_bench`).
 pub fn run_choice(config: &SimConfig, quick: bool, json: bool) {
     let (creatures, effort) = if quick { (20_000, (10, 15)) } else { (100_000, (30, 45)) };
-    for choice in choice_bench(config, creatures, 30.0, effort) {
+    for choice in choice_bench(config, creatures, &[10.0, 30.0], effort) {
         if json {
             println!("{}", serde_json::to_string(&choice).expect("a bench result serialises"));
         } else {
@@ -838,7 +844,8 @@ struct ChoiceCost {
 /// searched (else 0). The world's rules are left as they were, to play on.
 fn choice_cost_us(sim: &mut HeadlessSim, model: &CostModel, calls: usize, with_searches: bool) -> ChoiceCost {
     let (count, rules) = (played(sim).scenario.creature_count(), played(sim).rules.budget.clone());
-    playing(sim).costs = model.clone();
+    // Every creature worked out: what the incremental choice saves on one it leaves quiet.
+    (playing(sim).costs, playing(sim).rules.budget.incremental_choice) = (model.clone(), false);
     let mut time_choice = |creature_weight, budget_ms| timed_choice(sim, budget_ms, creature_weight, calls);
     let (unsearched_us, _) = time_choice(0.0, f32::MAX);
     let search_us = if with_searches {
@@ -968,7 +975,11 @@ fn choice_in_play_us(sim: &mut HeadlessSim, model: &CostModel, alone_us: f64, ef
     let count = played(sim).scenario.creature_count();
     let [pm, hybrid, _] = mix_us(played(sim), &priced, 0);
     let room_us = f64::from(priced.overhead_us(count as usize)) + f64::from(count) * (pm + hybrid) / 2.0;
-    in_play(sim, &priced, room_us, effort).beyond_the_cheap_us_per_creature(count)
+    // Every creature worked out, as in `choice_cost_us`.
+    let incremental = std::mem::replace(&mut playing(sim).rules.budget.incremental_choice, false);
+    let us = in_play(sim, &priced, room_us, effort).beyond_the_cheap_us_per_creature(count);
+    playing(sim).rules.budget.incremental_choice = incremental;
+    us
 }
 
 /// The rigid level's cost in play as a share of what `model` says of it (among four times as
