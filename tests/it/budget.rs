@@ -267,6 +267,9 @@ fn the_fixed_cost_and_the_choice_come_off_the_budget_before_any_creature() {
     let mut config = budget_scene(30, budget_ms);
     config.costs.fixed_us_per_frame = 300.0;
     config.costs.decision_us_per_creature = 5.0;
+    // Every creature worked out: a quiet one's choice would not be charged (the incremental
+    // choice, tested apart).
+    config.rules.budget.incremental_choice = false;
     let mut sim = HeadlessSim::new(config.clone());
     let mut rigid_seen = 0;
     for _ in 0..(10 * 30) {
