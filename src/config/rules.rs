@@ -143,8 +143,8 @@ pub struct BudgetRules {
     /// tile of the court the view cone misses, at their floor, not followed) wait in groups,
     /// their benefits worked out only for a group that reaches the front with room for a step:
     /// the same levels as working out every creature, at the cost of the few, where working out
-    /// every creature would cost more than the room it leaves. false: every creature's benefits
-    /// are worked out at every decision.
+    /// every creature would leave no room for a step beside the floors. false: every creature's
+    /// benefits are worked out at every decision.
     #[serde(default = "BudgetRules::incremental")]
     pub incremental_choice: bool,
 }

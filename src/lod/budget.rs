@@ -1966,16 +1966,42 @@ fn decide(
         }
     }
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget
-    // first: a quiet creature's working out only if its group is opened (below). Quiet creatures are
-    // left to their groups only where working out every creature costs more than the room
-    // that leaves, and the pass over them leaves room for a step: where the budget affords
-    // every creature, all listed at once cost less than their groups opened one by one (at
-    // 100,000 creatures with room for every step, 6 ms against 40).
+    // first. Quiet creatures are left to their groups, their working out paid for only if
+    // their group is opened, where working out every creature would leave no room for a step
+    // (a crowd whose choice would otherwise buy nothing beyond its floors) and the pass over
+    // them would: where the budget affords every creature, all listed at once cost less than
+    // their groups opened one by one (at 100,000 creatures with room for every step, 6 ms
+    // against 40, and at 30 ms frames of 40 ms and more).
     let (evaluate_us, overhead_us) = (config.costs.evaluation_us(count), config.costs.overhead_us(count));
     let incremental = config.rules.budget.incremental_choice
-        && count as f32 * evaluate_us > budget_us - overhead_us - floors.cost_us
+        && !floors.any_step_fits(budget_us - overhead_us)
         && floors.any_step_fits(budget_us - config.costs.floors_only_overhead_us(count));
-    let room_us = budget_us - overhead_us;
+    // Where a creature is quiet, the most its contacts with the puck, the areas and the walls
+    // can be worth (negative where it is not).
+    let (mut quiet_near, mut quiet) = (Vec::new(), 0);
+    if incremental {
+        let (tiles, following) = (scene.tiles(count), scene.camera.following);
+        quiet_near = vec![-1.0; count];
+        let mut i = 0;
+        for (entity, _, lod, s, choice) in tables.parts(0, count) {
+            for (((&entity, &lod), s), choice) in entity.iter().zip(lod).zip(s).zip(choice) {
+                let floor = floors.levels[i];
+                if lod == floor
+                    && choice.wanted == floor
+                    && following != Some(entity)
+                    && let Some(near) = tiles.quiet_near(s)
+                {
+                    (quiet_near[i], quiet) = (near, quiet + 1);
+                }
+                i += 1;
+            }
+        }
+    }
+    let room_us = budget_us - overhead_us + quiet as f32 * evaluate_us;
+    // Nor where the room it leaves for steps is less than working out the others costs: at
+    // the margin the choice spent on itself what bought no level (40,000 creatures at 4 ms,
+    // their mean frame up from 0.8 of the budget to 1.0 at the same levels, 2026-12-04).
+    let wasted = incremental && room_us - floors.cost_us < (count - quiet) as f32 * evaluate_us;
     // Where not one step up fits, the benefits are not worked out, nor the creatures listed,
     // and the choice costs the pass over them above (a crowd far over its budget), charged as
     // such. A creature at its kind's dearest level goes to its floor; the others keep their
@@ -1984,7 +2010,7 @@ fn decide(
     // their floors at once (40,000 creatures at 10 ms in the adaptive mode, 2026-11-27) made
     // frames of 181, 51 and 37 ms, and the correction that followed held the crowd at its
     // floors.
-    if !incremental && !floors.any_step_fits(room_us) {
+    if wasted || !floors.any_step_fits(room_us) {
         let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
         let dearest: Vec<Option<Lod>> = kinds.0.iter().map(|k| k.levels.iter().copied().max()).collect();
         let current_and_dearest =
@@ -2061,22 +2087,11 @@ fn decide(
             QuietGroup::gather(group, (row, row as u32), rigid_at_most, extra_us, may_be_exact, &hull);
         }
     };
-    // Where a creature is quiet, the most its contacts with the puck, the areas and the walls
-    // can be worth.
-    let (tiles, following) = (incremental.then(|| scene.tiles(count)), scene.camera.following);
-    let quiet_near = |(entity, _, &lod, s, choice): Row, floor: Lod| {
-        let tiles = tiles.as_ref()?;
-        (lod == floor && choice.wanted == floor && following != Some(entity)).then(|| tiles.quiet_near(s))?
-    };
+    let quiet_near = |i: usize| quiet_near.get(i).copied().filter(|&near| near >= 0.0);
     let mut settled_now = vec![false; count];
     let mut groups = vec![QuietGroup::default(); 2 * count.div_ceil(GROUP_ROWS)];
     let threads = count.div_ceil(chunk_len(config.scenario.creature_count(), count));
-    // Dear beside the room the floors leave, as though every creature were quiet.
-    let dear_us = floors.dear_us(if incremental {
-        budget_us - config.costs.floors_only_overhead_us(count)
-    } else {
-        room_us
-    });
+    let dear_us = floors.dear_us(room_us);
     let mut dealt: Vec<Vec<_>> = (0..threads).map(|_| Vec::new()).collect();
     let blocks = (floors.levels.chunks(DEALT_BLOCK)).zip(
         settled_now
@@ -2086,12 +2101,11 @@ fn decide(
     for (b, block) in blocks.enumerate() {
         dealt[b % threads].push(((b * DEALT_BLOCK) as u32, block));
     }
-    let mut chunks: Vec<Option<(Listing, usize)>> = (0..threads).map(|_| None).collect();
+    let mut chunks: Vec<Option<Listing>> = (0..threads).map(|_| None).collect();
     run_chunks(dealt.into_iter().zip(chunks.iter_mut()).map(|(blocks, listed)| {
         let (hull, made, quiet_near, quiet_step, tables) = (&hull, &made, &quiet_near, &quiet_step, &tables);
         move || {
             let mut listing = Listing::new(dear_us, blocks.iter().map(|(_, (floors, _))| floors.len()).sum());
-            let mut quiet = 0;
             for (first, (mut floors, (mut settled_now, groups))) in blocks {
                 let mut i = first;
                 // A table's part at a time: its slices side by side with the block's.
@@ -2105,10 +2119,9 @@ fn decide(
                         rows.zip(floors_here.iter().zip(settled_here))
                     {
                         let (row, at) = ((entity, c, lod, s, choice), (i - first) as usize);
-                        if let Some(near) = quiet_near(row, floor) {
+                        if let Some(near) = quiet_near(i as usize) {
                             let group = 2 * (at / GROUP_ROWS);
                             quiet_step(row, floor, near, i as usize, &mut groups[group..group + 2]);
-                            quiet += 1;
                         } else {
                             let candidate = made(row, floor, i as usize);
                             *settled = candidate.settled;
@@ -2120,14 +2133,10 @@ fn decide(
                 }
             }
             listing.finish();
-            *listed = Some((listing, quiet));
+            *listed = Some(listing);
         }
     }));
-    let (listed, quiet): (Vec<_>, Vec<_>) = chunks.into_iter().flatten().unzip();
-    let quiet_count = quiet.iter().sum::<usize>();
-    let (listed, quiet) = (Listing::merge(listed), quiet_count as f32);
-    // A quiet creature's working out is paid for only if its group is opened.
-    let room_us = room_us + quiet * evaluate_us;
+    let listed = Listing::merge(chunks.into_iter().flatten().collect());
     let floor_levels = floors.levels.clone();
     let mut crowd = Gathered {
         made: |i: usize| made(tables.row(i), floor_levels[i], i),
@@ -2136,7 +2145,7 @@ fn decide(
     };
     let groups = QuietGroups::of(&groups, evaluate_us);
     // Quiet creatures with no step up are in no group.
-    let stepless = quiet_count - groups.members.iter().sum::<u32>() as usize;
+    let stepless = quiet - groups.members.iter().sum::<u32>() as usize;
     // Only a creature that could still buy a level is searched for contacts with the others.
     let mut allocation = allocate_listed(&mut crowd, floors, settled_now, (listed, groups), room_us, &hull, |i| {
         let row @ (_, c, _, s, _) = tables.row(i);
@@ -2144,7 +2153,7 @@ fn decide(
         (bounds_of(row).rigid(scene, urgency), urgency)
     });
     allocation.settled.sort_unstable_by_key(|s| s.0);
-    allocation.predicted_us += overhead_us - quiet * evaluate_us;
+    allocation.predicted_us += overhead_us - quiet as f32 * evaluate_us;
     allocation.quiet += stepless;
     allocation
 }
