@@ -24,7 +24,7 @@
 use bevy::prelude::*;
 use serde::Serialize;
 use std::cell::Cell;
-use std::collections::VecDeque;
+use std::collections::{BinaryHeap, VecDeque};
 
 use super::select::{
     Area, DecisionInputs, LevelChoice, SimCamera, ViewReach, areas_now, select_levels, start_at_selected_levels,
@@ -183,7 +183,7 @@ trait Crowd<'a>: Sync {
     fn settle(&mut self, i: usize, rigid_benefit: f32);
     /// The steps up the hulls of the quiet creatures of `group` ([`QuietGroups`]) into
     /// `opened`, each creature marked in `settled_now` as it is: none where there are no groups.
-    fn open(&self, _group: usize, _hull: &Hull, _settled_now: &mut [bool], _opened: &mut Vec<Step>) {}
+    fn open(&self, _group: usize, _hull: &Hull, _settled_now: &mut [bool], _opened: &mut BinaryHeap<Step>) {}
 }
 
 impl<'a> Crowd<'a> for [Candidate<'a>] {
@@ -405,8 +405,6 @@ fn allocate_listed<'a, S: Send>(
     // The queue: the lists of steps, merged as it goes, best first.
     let threads = threads_for(levels.len() as u32);
     let mut lists: Vec<Queued<S>> = Vec::new();
-    let (open_us, group_needs) = (groups.open_us.clone(), groups.needs.clone());
-    let group_members = groups.members.clone();
     let mut opened_creatures = 0;
     if spent + cheapest_us <= budget_us {
         lists.push(Queued::cheap(listed.cheap, hull, threads));
@@ -417,11 +415,11 @@ fn allocate_listed<'a, S: Send>(
                 .map(|(_, dear)| Queued::dear(dear, hull, threads)),
         );
         if !groups.steps.is_empty() {
-            lists.push(Queued::groups(groups, threads));
+            lists.push(Queued::groups(&groups, threads));
         }
     }
     // The steps of the groups opened, and what opening them cost.
-    let (mut opened, mut opening, mut opened_us) = (std::collections::BinaryHeap::new(), Vec::new(), 0.0);
+    let (mut opened, mut opened_us) = (BinaryHeap::new(), 0.0);
     // The list last taken from, and the best next step of the others then: it is taken from
     // while its next step is above that.
     let mut run: Option<(usize, Option<Step>)> = None;
@@ -522,22 +520,15 @@ fn allocate_listed<'a, S: Send>(
             // would have been from the start. Once its room can never be had, they can change
             // nothing (the list's `live` test, for this one).
             let group = step.creature as usize;
-            let (any, exact) = group_needs[group];
+            let ((any, exact), open_us) = (groups.needs[group], groups.open_us[group]);
             // Its opening is paid at once and never given back, so it must fit beside the frame
             // as it will run, as a search must.
             let fits = spent + if searches_fit(running_us) { any } else { exact } <= budget_us
-                && (open_us[group] == 0.0 || running_us + open_us[group] <= budget_us);
+                && (open_us == 0.0 || running_us + open_us <= budget_us);
             if !rising || fits {
-                let mut steps = std::mem::take(&mut opening);
-                crowd.open(group, hull, &mut settled_now, &mut steps);
-                opened.extend(steps.drain(..));
-                opening = steps;
-                opened_creatures += group_members[group] as usize;
-                (spent, running_us, opened_us) = (
-                    spent + open_us[group],
-                    running_us + open_us[group],
-                    opened_us + open_us[group],
-                );
+                crowd.open(group, hull, &mut settled_now, &mut opened);
+                opened_creatures += groups.members[group] as usize;
+                (spent, running_us, opened_us) = (spent + open_us, running_us + open_us, opened_us + open_us);
             }
             continue;
         }
@@ -613,14 +604,14 @@ fn allocate_listed<'a, S: Send>(
         predicted_us,
         exceeded: predicted_us > budget_us,
         settled,
-        quiet: group_members.iter().sum::<u32>() as usize - opened_creatures,
+        quiet: groups.members.iter().sum::<u32>() as usize - opened_creatures,
     }
 }
 
 /// The steps of settled creatures, waiting beside the list, and the least any of them ever
 /// needed (what is left needs no less).
 struct Follows {
-    heap: std::collections::BinaryHeap<Step>,
+    heap: BinaryHeap<Step>,
     extra_us: f32,
 }
 
@@ -835,7 +826,7 @@ impl<S: Send> Queued<S> {
     }
 
     /// The quiet creatures' groups, each a step above all of theirs ([`QuietGroups`]).
-    fn groups(groups: QuietGroups, threads: usize) -> Self {
+    fn groups(groups: &QuietGroups, threads: usize) -> Self {
         let mut need_from = vec![(f32::INFINITY, f32::INFINITY); groups.steps.len() + 1];
         for (i, step) in groups.steps.iter().enumerate().rev() {
             let ((any, exact), need) = (need_from[i + 1], groups.needs[step.creature as usize]);
@@ -843,7 +834,7 @@ impl<S: Send> Queued<S> {
         }
         Self {
             sorted: groups.steps.len(),
-            steps: groups.steps,
+            steps: groups.steps.clone(),
             best: None,
             next: 0,
             need: Need::From(need_from),
@@ -1731,7 +1722,7 @@ impl QuietGroup {
         crowd: &(impl Crowd<'a> + ?Sized),
         hull: &Hull,
         settled_now: &mut [bool],
-        opened: &mut Vec<Step>,
+        opened: &mut BinaryHeap<Step>,
     ) {
         let mut members = members;
         while members != 0 {
@@ -2055,34 +2046,20 @@ fn decide(
     // each core's steps sorted while they are at hand, then merged. The creatures are dealt to
     // the cores a block at a time in turn: what one costs here depends on where it is (in view
     // or not), and the query keeps neighbours together, so that halves of it would not balance.
-    // What a quiet creature's step to rigid adds, by kind and floor (at its floor, it switches
-    // from there): none where its kind has no rigid level above the floor.
-    let rigid_extra_us: Vec<[Option<f32>; 3]> = (kinds.0.iter().zip(&costs))
-        .map(|(kind, &costs)| {
-            Lod::ALL.map(|floor| {
-                let c = Candidate {
-                    serial: 0,
-                    current: floor,
-                    last: floor,
-                    floor,
-                    levels: &kind.levels,
-                    costs,
-                    benefit: [0.0; 3],
-                    settled: true,
-                };
-                let p = c.priced(0.0);
-                (floor < Lod::Rigid && kind.levels.contains(&Lod::Rigid))
-                    .then(|| p.cost_us[Lod::Rigid as usize] - p.cost_us[floor as usize])
-            })
-        })
-        .collect();
+    // What a quiet creature's step to rigid adds (at its floor, it switches from there): none
+    // where its kind has no rigid level above the floor.
+    let rigid_extra_us = |kind: usize, floor: Lod| {
+        let at = at_floor[kind][floor as usize][floor as usize].frame_at_us;
+        (floor < Lod::Rigid && kinds[kind].levels.contains(&Lod::Rigid))
+            .then(|| at[Lod::Rigid as usize] - at[floor as usize])
+    };
     // A quiet creature's one step, gathered into its group: at most the tile's contacts with the
     // puck, the areas and the walls, or the contacts with other creatures its search stands at
     // (or could be, without one), over what it adds.
     let quiet_step = |(_, c, _, _, choice): Row, floor: Lod, near: f32, row: usize, group: &mut [QuietGroup]| {
         let standing = choice.crowding.filter(|&(_, at)| now_s - at < rules.contact_recheck_s);
         let rigid_at_most = near.max(rules.creature_weight * standing.map_or(1.0, |s| s.0));
-        if let Some(extra_us) = rigid_extra_us[c.kind][floor as usize] {
+        if let Some(extra_us) = rigid_extra_us(c.kind, floor) {
             let may_be_exact = standing.is_some() || near >= rules.creature_weight;
             QuietGroup::gather(group, (row, row as u32), rigid_at_most, extra_us, may_be_exact, &hull);
         }
@@ -2252,7 +2229,7 @@ impl<'a, F: Fn(usize) -> Candidate<'a> + Sync> Crowd<'a> for Gathered<F> {
         self.settled.insert(i, rigid_benefit);
     }
 
-    fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut Vec<Step>) {
+    fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut BinaryHeap<Step>) {
         QuietGroup::open(group, self.members[group], self, hull, settled_now, opened);
     }
 }
@@ -2602,7 +2579,7 @@ mod tests {
             self.crowd[..].settle(i, rigid_benefit);
         }
 
-        fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut Vec<Step>) {
+        fn open(&self, group: usize, hull: &Hull, settled_now: &mut [bool], opened: &mut BinaryHeap<Step>) {
             let members = self.members[group].count_ones() as usize;
             self.opened.fetch_add(members, std::sync::atomic::Ordering::Relaxed);
             QuietGroup::open(group, self.members[group], self, hull, settled_now, opened);
