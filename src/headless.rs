@@ -45,6 +45,21 @@ impl HeadlessSim {
         // The first update runs Startup and sets the clocks going without a fixed tick.
         app.insert_resource(TimeUpdateStrategy::FixedTimesteps(0));
         app.update();
+        // The schedules it did not run (the fixed ticks') are built now, not in the first frame:
+        // among 100,000 creatures their building made it 12 ms against 4 for the next ones.
+        let labels: Vec<_> = app
+            .world()
+            .resource::<Schedules>()
+            .iter()
+            .map(|(_, s)| s.label())
+            .collect();
+        for label in labels {
+            app.world_mut().schedule_scope(label, |world, schedule| {
+                if let Err(error) = schedule.initialize(world) {
+                    panic!("the schedule {label:?} does not build: {error:?}");
+                }
+            });
+        }
         run_ticks_per_update(app.world_mut(), ticks_per_update);
         Self {
             app,

@@ -994,6 +994,8 @@ const MAX_SETTLED_AHEAD: usize = 4096;
 /// [`allocate`] gives every creature its floor, so they are the choice).
 struct Floors {
     levels: Vec<Lod>,
+    /// Each creature's level where no step fits ([`Floors::holding_cheap_levels`]).
+    held: Vec<Lod>,
     /// What each creature adds to the frame as it will run at each level, by `Lod as usize`:
     /// the knapsack's closing sums read these, not the creatures' candidates.
     frame_at_us: Vec<[f32; 3]>,
@@ -1001,6 +1003,8 @@ struct Floors {
     cost_us: f32,
     /// The frame as it will run at the floors (creatures going down still cost their level), us.
     frame_us: f32,
+    /// The frame as it will run at the levels held, us.
+    held_frame_us: f32,
     /// The cheapest step up from any floor, us.
     cheapest_step_us: f32,
     /// Whether every creature's levels cost no less than the one below.
@@ -1012,6 +1016,8 @@ struct Floors {
 #[derive(Clone, Copy, Debug)]
 struct AtFloor {
     floor: Lod,
+    /// Below its kind's dearest level, the level it has; else its floor.
+    held: Lod,
     cost_us: f32,
     frame_at_us: [f32; 3],
     cheapest_step_us: f32,
@@ -1020,8 +1026,10 @@ struct AtFloor {
 
 impl From<&Candidate<'_>> for AtFloor {
     fn from(c: &Candidate) -> Self {
+        let dearest = c.levels.iter().copied().max().unwrap_or(c.current);
         Self {
             floor: c.floor,
+            held: if c.current < dearest { c.current } else { c.floor },
             cost_us: c.cost_us(c.floor),
             frame_at_us: Lod::ALL.map(|l| c.frame_cost_us(l)),
             cheapest_step_us: c.cheapest_step_above_floor_us(&c.priced(0.0)),
@@ -1034,9 +1042,11 @@ impl Floors {
     fn with_capacity(creatures: usize) -> Self {
         Self {
             levels: Vec::with_capacity(creatures),
+            held: Vec::with_capacity(creatures),
             frame_at_us: Vec::with_capacity(creatures),
             cost_us: 0.0,
             frame_us: 0.0,
+            held_frame_us: 0.0,
             cheapest_step_us: f32::INFINITY,
             rising: true,
         }
@@ -1044,11 +1054,44 @@ impl Floors {
 
     fn add(&mut self, c: AtFloor) {
         self.levels.push(c.floor);
+        self.held.push(c.held);
         self.frame_at_us.push(c.frame_at_us);
         self.cost_us += c.cost_us;
         self.frame_us += c.frame_at_us[c.floor as usize];
+        self.held_frame_us += c.frame_at_us[c.held as usize];
         self.cheapest_step_us = self.cheapest_step_us.min(c.cheapest_step_us);
         self.rising &= c.rising;
+    }
+
+    /// `count` creatures' floors, a part of [`FLOORS_PART`] at a time across `threads` cores,
+    /// each part's added by `fill(first, to)`. The parts' sums are added in their order: the
+    /// same on any number of cores, and those of a single part the same as one by one.
+    fn gathered(count: usize, threads: usize, fill: impl Fn(usize, &mut Floors) + Sync) -> Self {
+        let mut parts: Vec<Option<Floors>> = (0..count.div_ceil(FLOORS_PART)).map(|_| None).collect();
+        let per_thread = parts.len().div_ceil(threads.max(1)).max(1);
+        run_chunks(parts.chunks_mut(per_thread).enumerate().map(|(t, slots)| {
+            let fill = &fill;
+            move || {
+                for (k, slot) in slots.iter_mut().enumerate() {
+                    let first = (t * per_thread + k) * FLOORS_PART;
+                    let mut part = Floors::with_capacity(FLOORS_PART.min(count - first));
+                    fill(first, &mut part);
+                    *slot = Some(part);
+                }
+            }
+        }));
+        let mut floors = Floors::with_capacity(count);
+        for part in parts.into_iter().flatten() {
+            floors.levels.extend(part.levels);
+            floors.held.extend(part.held);
+            floors.frame_at_us.extend(part.frame_at_us);
+            floors.cost_us += part.cost_us;
+            floors.frame_us += part.frame_us;
+            floors.held_frame_us += part.held_frame_us;
+            floors.cheapest_step_us = floors.cheapest_step_us.min(part.cheapest_step_us);
+            floors.rising &= part.rising;
+        }
+        floors
     }
 
     /// What a step must need to be dear ([`Listing`]): over a [`DEAR_STEPS`]th of the room the
@@ -1066,18 +1109,10 @@ impl Floors {
         self.cost_us + self.cheapest_step_us <= budget_us
     }
 
-    /// Each creature below its kind's dearest level (the second of each pair, the first its
-    /// level now) kept at the level it has, not sent to its floor; the frame as it will run
-    /// then.
-    fn holding_cheap_levels(mut self, current_and_dearest: impl Iterator<Item = (Lod, Lod)>) -> Self {
-        self.frame_us = 0.0;
-        let levels = self.levels.iter_mut().zip(&self.frame_at_us);
-        for ((level, at), (current, dearest)) in levels.zip(current_and_dearest) {
-            if current < dearest {
-                *level = current;
-            }
-            self.frame_us += at[*level as usize];
-        }
+    /// Each creature below its kind's dearest level kept at the level it has, not sent to its
+    /// floor; the frame as it will run then.
+    fn holding_cheap_levels(mut self) -> Self {
+        (self.levels, self.frame_us) = (std::mem::take(&mut self.held), self.held_frame_us);
         self
     }
 
@@ -1873,7 +1908,7 @@ impl Allocation<f32> {
         searched: &mut std::iter::Peekable<std::slice::Iter<(usize, f32)>>,
         row: usize,
         now_s: f32,
-        choice: &mut Mut<LevelChoice>,
+        choice: &mut LevelChoice,
     ) {
         let level = self.levels[row];
         if choice.wanted != level {
@@ -1887,6 +1922,9 @@ impl Allocation<f32> {
 
 /// Creatures dealt to a core at a time by the budget's choice.
 const DEALT_BLOCK: usize = 1024;
+
+/// Creatures whose floors are summed together before the parts' sums are ([`Floors::gathered`]).
+const FLOORS_PART: usize = 4096;
 
 /// The allocation for every creature now, in the query's order; `starting`, for a new world's
 /// creatures, built at the levels it gives them.
@@ -1948,14 +1986,15 @@ fn decide(
         })
         .collect();
     let count = tables.len();
-    let mut floors = Floors::with_capacity(count);
     // A table's slices at a time: a row apiece through `Tables::rows` (its flattening's checks
     // at every row) made this pass about twice as slow among 100,000 creatures.
-    for (_, c, lod, _, choice) in tables.parts(0, count) {
-        for ((c, &lod), choice) in c.iter().zip(lod).zip(choice) {
-            floors.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
+    let floors = Floors::gathered(count, threads_for(config.scenario.creature_count()), |first, part| {
+        for (_, c, lod, _, choice) in tables.parts(first, first + FLOORS_PART) {
+            for ((c, &lod), choice) in c.iter().zip(lod).zip(choice) {
+                part.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
+            }
         }
-    }
+    });
     // The frame's fixed cost (court, puck, schedule) and this choice's come off the budget
     // first. Quiet creatures are left to their groups, their working out paid for only if
     // their group is opened, where working out every creature would leave no room for a step
@@ -2002,13 +2041,8 @@ fn decide(
     // frames of 181, 51 and 37 ms, and the correction that followed held the crowd at its
     // floors.
     if wasted || !floors.any_step_fits(room_us) {
-        let overhead_us = config.costs.floors_only_overhead_us(floors.levels.len());
-        let dearest: Vec<Option<Lod>> = kinds.0.iter().map(|k| k.levels.iter().copied().max()).collect();
-        let current_and_dearest =
-            (tables.rows(0, count)).map(|(_, c, &lod, _, _)| (lod, dearest[c.kind].unwrap_or(lod)));
-        return floors
-            .holding_cheap_levels(current_and_dearest)
-            .allocation(budget_us, overhead_us);
+        let overhead_us = config.costs.floors_only_overhead_us(count);
+        return floors.holding_cheap_levels().allocation(budget_us, overhead_us);
     }
     let rules = &config.rules.budget;
     let hull = Hull {
@@ -2303,8 +2337,14 @@ fn choose_by_budget(inputs: DecisionInputs, mut tally: ResMut<BudgetTally>, mut 
     // In the query's order, as decided.
     let now_s = inputs.clock.seconds() as f32;
     let mut searched = decision.settled.iter().peekable();
-    for (row, (.., mut choice)) in creatures.iter_mut().enumerate() {
-        decision.write(&mut searched, row, now_s, &mut choice);
+    let mut row = 0;
+    // A table's column at a time, its change ticks left as they were: nothing reads them, and
+    // a row apiece through the query cost a quarter of a millisecond among 100,000 creatures.
+    for (.., mut choices) in creatures.contiguous_iter_mut().expect(DENSE) {
+        for choice in choices.bypass_change_detection() {
+            decision.write(&mut searched, row, now_s, choice);
+            row += 1;
+        }
     }
 }
 
@@ -2443,6 +2483,60 @@ mod tests {
         let mut floors = Floors::with_capacity(crowd.len());
         crowd.iter().for_each(|c| floors.add(c.into()));
         floors
+    }
+
+    #[test]
+    fn a_crowds_floors_sum_the_same_on_any_number_of_cores_and_one_parts_as_one_by_one() {
+        bevy::tasks::ComputeTaskPool::get_or_init(bevy::tasks::TaskPool::default);
+        let mut r = uniform(11);
+        let levels = [Lod::PointMass, Lod::Hybrid, Lod::Rigid];
+        let crowd: Vec<Candidate> = (0..3 * FLOORS_PART as u32 + 17)
+            .map(|i| {
+                let costs = LevelCosts {
+                    point_mass_us_per_frame: 0.1 + r(),
+                    hybrid_us_per_frame: 1.0 + r(),
+                    rigid_us_per_frame: 50.0 + 100.0 * r(),
+                    ..COSTS
+                };
+                Candidate {
+                    costs,
+                    floor: levels[(3.0 * r()) as usize % 2],
+                    ..candidate(i, levels[(3.0 * r()) as usize % 3], 1.0)
+                }
+            })
+            .collect();
+        let gathered = |crowd: &[Candidate], threads: usize| {
+            Floors::gathered(crowd.len(), threads, |first, part| {
+                let to = (first + FLOORS_PART).min(crowd.len());
+                crowd[first..to].iter().for_each(|c| part.add(c.into()));
+            })
+        };
+        let sums = |f: &Floors| {
+            let held = f.held.clone();
+            (
+                f.levels.clone(),
+                held,
+                [f.cost_us, f.frame_us, f.held_frame_us, f.cheapest_step_us].map(f32::to_bits),
+            )
+        };
+        let one = sums(&gathered(&crowd, 1));
+        for threads in [2, 3, 8] {
+            assert_eq!(sums(&gathered(&crowd, threads)), one, "{threads} threads");
+        }
+        // The parts' sums in their order: within rounding of one by one, and a crowd of one part
+        // bit for bit.
+        let (by_one, part) = (floors_of(&crowd), &crowd[..FLOORS_PART]);
+        assert_eq!(
+            (one.0.clone(), one.1.clone()),
+            (by_one.levels.clone(), by_one.held.clone())
+        );
+        assert!((f32::from_bits(one.2[0]) - by_one.cost_us).abs() <= 1e-5 * by_one.cost_us);
+        assert_eq!(sums(&gathered(part, 2)), sums(&floors_of(part)));
+        // Held where no step fits: below the dearest level, the level it has; else its floor.
+        let held = floors_of(&crowd).holding_cheap_levels();
+        for (c, &level) in crowd.iter().zip(&held.levels) {
+            assert_eq!(level, if c.current < Lod::Rigid { c.current } else { c.floor });
+        }
     }
 
     #[test]

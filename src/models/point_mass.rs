@@ -195,6 +195,10 @@ impl FrameStep {
         // `behind` is the first byte of each two, and a `bool` is 0 or 1.
         const BEHIND_BYTES: u64 = 0x00FF_00FF_00FF_00FF;
         const ALL_BEHIND: u64 = 0x0001_0001_0001_0001;
+        // At a decision's tick none is behind yet: the first is tested alone before a run.
+        if frames.get(from).is_some_and(|f| !f.behind) {
+            return Some(from);
+        }
         let mut start = from;
         while start < frames.len() {
             let run = &frames[start..(start + RUN).min(frames.len())];
