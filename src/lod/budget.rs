@@ -1068,18 +1068,12 @@ impl Floors {
     /// same on any number of cores, and those of a single part the same as one by one.
     fn gathered(count: usize, threads: usize, fill: impl Fn(usize, &mut Floors) + Sync) -> Self {
         let mut parts: Vec<Option<Floors>> = (0..count.div_ceil(FLOORS_PART)).map(|_| None).collect();
-        let per_thread = parts.len().div_ceil(threads.max(1)).max(1);
-        run_chunks(parts.chunks_mut(per_thread).enumerate().map(|(t, slots)| {
-            let fill = &fill;
-            move || {
-                for (k, slot) in slots.iter_mut().enumerate() {
-                    let first = (t * per_thread + k) * FLOORS_PART;
-                    let mut part = Floors::with_capacity(FLOORS_PART.min(count - first));
-                    fill(first, &mut part);
-                    *slot = Some(part);
-                }
-            }
-        }));
+        each_part(&mut parts, threads, |p, slot| {
+            let first = p * FLOORS_PART;
+            let mut part = Floors::with_capacity(FLOORS_PART.min(count - first));
+            fill(first, &mut part);
+            *slot = Some(part);
+        });
         let mut floors = Floors::with_capacity(count);
         for part in parts.into_iter().flatten() {
             floors.levels.extend(part.levels);
@@ -1926,6 +1920,19 @@ const DEALT_BLOCK: usize = 1024;
 /// Creatures whose floors are summed together before the parts' sums are ([`Floors::gathered`]).
 const FLOORS_PART: usize = 4096;
 
+/// Runs `work` on each of `parts` with its place, a run of them on each of `threads` cores.
+fn each_part<T: Send>(parts: &mut [T], threads: usize, work: impl Fn(usize, &mut T) + Sync) {
+    let per_thread = parts.len().div_ceil(threads.max(1)).max(1);
+    run_chunks(parts.chunks_mut(per_thread).enumerate().map(|(t, run)| {
+        let work = &work;
+        move || {
+            for (k, part) in run.iter_mut().enumerate() {
+                work(t * per_thread + k, part);
+            }
+        }
+    }));
+}
+
 /// The allocation for every creature now, in the query's order; `starting`, for a new world's
 /// creatures, built at the levels it gives them.
 fn decide(
@@ -2012,20 +2019,30 @@ fn decide(
     if incremental {
         let (tiles, following) = (scene.tiles(count), scene.camera.following);
         quiet_near = vec![-1.0; count];
-        let mut i = 0;
-        for (entity, _, lod, s, choice) in tables.parts(0, count) {
-            for (((&entity, &lod), s), choice) in entity.iter().zip(lod).zip(s).zip(choice) {
-                let floor = floors.levels[i];
-                if lod == floor
-                    && choice.wanted == floor
-                    && following != Some(entity)
-                    && let Some(near) = tiles.quiet_near(s)
-                {
-                    (quiet_near[i], quiet) = (near, quiet + 1);
+        // A part at a time across the cores, as the floors' pass.
+        let mut parts: Vec<_> = quiet_near.chunks_mut(FLOORS_PART).map(|near| (near, 0)).collect();
+        each_part(
+            &mut parts,
+            threads_for(config.scenario.creature_count()),
+            |p, (near, quiet)| {
+                let first = p * FLOORS_PART;
+                let mut i = first;
+                for (entity, _, lod, s, choice) in tables.parts(first, first + near.len()) {
+                    for (((&entity, &lod), s), choice) in entity.iter().zip(lod).zip(s).zip(choice) {
+                        let floor = floors.levels[i];
+                        if lod == floor
+                            && choice.wanted == floor
+                            && following != Some(entity)
+                            && let Some(at_most) = tiles.quiet_near(s)
+                        {
+                            (near[i - first], *quiet) = (at_most, *quiet + 1);
+                        }
+                        i += 1;
+                    }
                 }
-                i += 1;
-            }
-        }
+            },
+        );
+        quiet = parts.iter().map(|p| p.1).sum();
     }
     let room_us = budget_us - overhead_us + quiet as f32 * evaluate_us;
     // Nor where the room it leaves for steps is less than working out the others costs: at
