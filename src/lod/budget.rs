@@ -1064,8 +1064,9 @@ impl Floors {
     }
 
     /// `count` creatures' floors, a part of [`FLOORS_PART`] at a time across `threads` cores,
-    /// each part's added by `fill(first, to)`. The parts' sums are added in their order: the
-    /// same on any number of cores, and those of a single part the same as one by one.
+    /// each part's added by `fill(first, part)` from the creature at `first` on. The parts'
+    /// sums are added in their order: the same on any number of cores, and those of a single
+    /// part the same as one by one.
     fn gathered(count: usize, threads: usize, fill: impl Fn(usize, &mut Floors) + Sync) -> Self {
         let mut parts: Vec<Option<Floors>> = (0..count.div_ceil(FLOORS_PART)).map(|_| None).collect();
         each_part(&mut parts, threads, |p, slot| {
@@ -1995,7 +1996,8 @@ fn decide(
     let count = tables.len();
     // A table's slices at a time: a row apiece through `Tables::rows` (its flattening's checks
     // at every row) made this pass about twice as slow among 100,000 creatures.
-    let floors = Floors::gathered(count, threads_for(config.scenario.creature_count()), |first, part| {
+    let cores = threads_for(config.scenario.creature_count());
+    let floors = Floors::gathered(count, cores, |first, part| {
         for (_, c, lod, _, choice) in tables.parts(first, first + FLOORS_PART) {
             for ((c, &lod), choice) in c.iter().zip(lod).zip(choice) {
                 part.add(at_floor[c.kind][floor(c, lod, choice) as usize][lod as usize]);
@@ -2021,27 +2023,23 @@ fn decide(
         quiet_near = vec![-1.0; count];
         // A part at a time across the cores, as the floors' pass.
         let mut parts: Vec<_> = quiet_near.chunks_mut(FLOORS_PART).map(|near| (near, 0)).collect();
-        each_part(
-            &mut parts,
-            threads_for(config.scenario.creature_count()),
-            |p, (near, quiet)| {
-                let first = p * FLOORS_PART;
-                let mut i = first;
-                for (entity, _, lod, s, choice) in tables.parts(first, first + near.len()) {
-                    for (((&entity, &lod), s), choice) in entity.iter().zip(lod).zip(s).zip(choice) {
-                        let floor = floors.levels[i];
-                        if lod == floor
-                            && choice.wanted == floor
-                            && following != Some(entity)
-                            && let Some(at_most) = tiles.quiet_near(s)
-                        {
-                            (near[i - first], *quiet) = (at_most, *quiet + 1);
-                        }
-                        i += 1;
+        each_part(&mut parts, cores, |p, (near, quiet)| {
+            let first = p * FLOORS_PART;
+            let mut i = first;
+            for (entity, _, lod, s, choice) in tables.parts(first, first + near.len()) {
+                for (((&entity, &lod), s), choice) in entity.iter().zip(lod).zip(s).zip(choice) {
+                    let floor = floors.levels[i];
+                    if lod == floor
+                        && choice.wanted == floor
+                        && following != Some(entity)
+                        && let Some(at_most) = tiles.quiet_near(s)
+                    {
+                        (near[i - first], *quiet) = (at_most, *quiet + 1);
                     }
+                    i += 1;
                 }
-            },
-        );
+            }
+        });
         quiet = parts.iter().map(|p| p.1).sum();
     }
     let room_us = budget_us - overhead_us + quiet as f32 * evaluate_us;
@@ -2529,10 +2527,9 @@ mod tests {
             })
         };
         let sums = |f: &Floors| {
-            let held = f.held.clone();
             (
                 f.levels.clone(),
-                held,
+                f.held.clone(),
                 [f.cost_us, f.frame_us, f.held_frame_us, f.cheapest_step_us].map(f32::to_bits),
             )
         };
